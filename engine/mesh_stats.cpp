@@ -1,0 +1,77 @@
+#include "engine/mesh_stats.h"
+
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+namespace mvflow {
+
+MeshStats compute_mesh_stats(const Mesh& mesh) {
+  const TriMesh& m = mesh.topology;
+  MeshStats s;
+  s.vertices = m.n_vertices();
+  s.faces = m.n_faces();
+  s.edges = m.n_edges();
+
+  double sum = 0.0;
+  s.shortest_edge = std::numeric_limits<double>::infinity();
+  for (auto e : m.edges()) {
+    const double length = m.calc_edge_length(e);
+    s.shortest_edge = std::min(s.shortest_edge, length);
+    s.longest_edge = std::max(s.longest_edge, length);
+    sum += length;
+    if (m.is_boundary(e)) ++s.boundary_edges;
+  }
+  if (s.edges == 0) s.shortest_edge = 0.0;
+  s.mean_edge = s.edges ? sum / static_cast<double>(s.edges) : 0.0;
+
+  std::size_t used_vertices = 0;
+  for (auto v : m.vertices()) {
+    s.bounding_box.extend(to_eigen(m.point(v)));
+    if (m.is_isolated(v)) {
+      ++s.isolated_vertices;
+      continue;
+    }
+    ++used_vertices;
+    if (!m.is_manifold(v)) ++s.non_manifold_vertices;
+  }
+
+  // Boundary loops: follow boundary halfedges once each.
+  std::vector<char> seen(m.n_halfedges(), 0);
+  for (auto h : m.halfedges()) {
+    if (!m.is_boundary(h) || seen[h.idx()]) continue;
+    ++s.boundary_loops;
+    auto current = h;
+    do {
+      seen[current.idx()] = 1;
+      current = m.next_halfedge_handle(current);
+    } while (current != h && !seen[current.idx()]);
+  }
+
+  // Components over faces (flood fill through shared edges).
+  std::vector<int> component(m.n_faces(), -1);
+  std::vector<TriMesh::FaceHandle> stack;
+  for (auto f : m.faces()) {
+    if (component[f.idx()] >= 0) continue;
+    const int id = static_cast<int>(s.components++);
+    component[f.idx()] = id;
+    stack.push_back(f);
+    while (!stack.empty()) {
+      const auto current = stack.back();
+      stack.pop_back();
+      for (auto neighbour : m.ff_range(current))
+        if (component[neighbour.idx()] < 0) {
+          component[neighbour.idx()] = id;
+          stack.push_back(neighbour);
+        }
+    }
+  }
+
+  s.euler_characteristic = static_cast<long>(used_vertices) - static_cast<long>(s.edges) +
+                           static_cast<long>(s.faces);
+  s.genus = (2 * static_cast<long>(s.components) - s.euler_characteristic -
+             static_cast<long>(s.boundary_loops)) / 2;
+  return s;
+}
+
+}  // namespace mvflow

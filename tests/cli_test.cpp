@@ -1,0 +1,90 @@
+// The `mvflow` program as a user runs it: exit codes, output, and error messages.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <sys/wait.h>
+
+#include "test_support.h"
+
+namespace mvflow {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kDefaultScene = fs::path(MVFLOW_TEST_DATA) / "scenes" / "default";
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CommandResult run(const std::string& arguments) {
+  const std::string command = std::string(MVFLOW_BINARY) + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) result.output += buffer.data();
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+TEST(Cli, VersionAndHelpExitZero) {
+  EXPECT_EQ(run("--version").exit_code, 0);
+  const CommandResult help = run("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("info"), std::string::npos);
+  EXPECT_EQ(run("info --help").exit_code, 0);
+  EXPECT_EQ(run("convert --help").exit_code, 0);
+}
+
+TEST(Cli, BadUsageExitsTwo) {
+  EXPECT_EQ(run("").exit_code, 2);
+  EXPECT_EQ(run("no-such-command").exit_code, 2);
+  EXPECT_EQ(run("info").exit_code, 2);
+  EXPECT_EQ(run("--log-level loud info x").exit_code, 2);
+}
+
+TEST(Cli, InfoDescribesTheDefaultScene) {
+  test::ScratchFolder folder;
+  const CommandResult r = run("info " + kDefaultScene.string() + " --json " + (folder / "info.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("cameras    4 (middlebury"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("4 × 80x60"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("6 vertices, 8 faces, 12 edges"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("genus 0"), std::string::npos) << r.output;
+  const std::string json = test::read_text(folder / "info.json");
+  EXPECT_NE(json.find("\"coverage\""), std::string::npos);
+  // The 4 ring cameras all see the box centre.
+  EXPECT_NE(r.output.find("   4   4   4"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BadInputExitsOneNamingTheFile) {
+  test::ScratchFolder folder;
+  test::write_text(folder / "broken_par.txt", "2\nview.png 1 0 0 0 1 0 0 0 1\n");
+  const CommandResult r = run("info " + (folder / "broken_par.txt").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("broken_par.txt:2"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("terminate"), std::string::npos) << r.output;
+}
+
+TEST(Cli, ConvertMeshAndCamerasRoundTrip) {
+  test::ScratchFolder folder;
+  const auto ply = folder / "init.ply";
+  CommandResult r = run("convert " + (kDefaultScene / "init.off").string() + " " + ply.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run("info " + kDefaultScene.string() + " --mesh " + ply.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("6 vertices, 8 faces"), std::string::npos) << r.output;
+
+  // Middlebury → COLMAP needs image sizes, which convert reads from the images.
+  r = run("convert " + kDefaultScene.string() + " " + (folder / "colmap").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(folder / "colmap" / "cameras.txt"));
+  EXPECT_NE(test::read_text(folder / "colmap" / "cameras.txt").find(" 80 60 "), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mvflow

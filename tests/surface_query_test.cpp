@@ -1,0 +1,108 @@
+// Embree-backed queries against brute force over every triangle.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+#include "engine/error.h"
+#include "engine/surface_query.h"
+#include "test_support.h"
+
+namespace mvflow {
+namespace {
+
+// Möller–Trumbore in double: the independent reference for ray hits.
+std::optional<double> brute_force_hit(const IndexedMesh& mesh, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+  std::optional<double> best;
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.positions[t[0]], e1 = mesh.positions[t[1]] - a, e2 = mesh.positions[t[2]] - a;
+    const Eigen::Vector3d p = d.cross(e2);
+    const double det = e1.dot(p);
+    if (std::abs(det) < 1e-14) continue;
+    const Eigen::Vector3d s = o - a;
+    const double u = s.dot(p) / det;
+    const Eigen::Vector3d q = s.cross(e1);
+    const double v = d.dot(q) / det;
+    const double distance = e2.dot(q) / det;
+    if (u < 0 || v < 0 || u + v > 1 || distance <= 0) continue;
+    if (!best || distance < *best) best = distance;
+  }
+  return best;
+}
+
+double brute_force_distance(const IndexedMesh& mesh, const Eigen::Vector3d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& t : mesh.triangles)
+    best = std::min(best, (closest_point_on_triangle(p, mesh.positions[t[0]], mesh.positions[t[1]],
+                                                     mesh.positions[t[2]]) - p).norm());
+  return best;
+}
+
+TEST(ClosestPointOnTriangle, RegionsMatchHandAnswers) {
+  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  EXPECT_LT((closest_point_on_triangle({0.2, 0.3, 5}, a, b, c) - Eigen::Vector3d(0.2, 0.3, 0)).norm(), 1e-15);  // face
+  EXPECT_EQ(closest_point_on_triangle({-1, -1, 0}, a, b, c), a);                               // vertex
+  EXPECT_TRUE(closest_point_on_triangle({0.5, -2, 1}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0, 0)));  // edge
+  EXPECT_TRUE(closest_point_on_triangle({1, 1, 0}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));   // hypotenuse
+}
+
+TEST(SurfaceQuery, ClosestPointEqualsBruteForce) {
+  const IndexedMesh mesh = test::torus(24, 12);
+  const SurfaceQuery query(mesh);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(-4, 4);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random) / 2);
+    const ClosestPoint found = query.closest_point(p);
+    EXPECT_NEAR(found.distance, brute_force_distance(mesh, p), 1e-12);
+    EXPECT_NEAR((found.point - p).norm(), found.distance, 1e-12);
+  }
+}
+
+TEST(SurfaceQuery, RayHitsEqualBruteForce) {
+  const IndexedMesh mesh = test::torus(24, 12);
+  const SurfaceQuery query(mesh);
+  std::mt19937 random(5);
+  std::normal_distribution<double> gaussian;
+  int hits = 0;
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3d origin(3 * gaussian(random), 3 * gaussian(random), 3 * gaussian(random));
+    // Every other ray aims near a mesh vertex, so that hits and misses are both common.
+    const Eigen::Vector3d jitter(gaussian(random), gaussian(random), gaussian(random));
+    const Eigen::Vector3d target =
+        i % 2 ? Eigen::Vector3d(mesh.positions[i % mesh.positions.size()] + 0.2 * jitter) : Eigen::Vector3d(origin + jitter);
+    const Eigen::Vector3d direction = (target - origin).normalized();
+    const auto expected = brute_force_hit(mesh, origin, direction);
+    const auto found = query.intersect(origin, direction);
+    ASSERT_EQ(found.has_value(), expected.has_value()) << "ray " << i;
+    if (!expected) continue;
+    ++hits;
+    EXPECT_NEAR(found->distance, *expected, 1e-4 * (1 + *expected));  // Embree traces in float
+    EXPECT_EQ(query.occluded(origin, direction, 0, *expected * 1.01), true);
+    EXPECT_EQ(query.occluded(origin, direction, 0, *expected * 0.99), false);
+  }
+  EXPECT_GT(hits, 200);  // the test exercised hits, not only misses
+}
+
+TEST(SurfaceQuery, RefitFollowsMovedVertices) {
+  IndexedMesh mesh = test::octahedron();
+  SurfaceQuery query(mesh);
+  EXPECT_NEAR(query.closest_point({0, 0, 3}).distance, 2.0, 1e-12);
+  for (auto& p : mesh.positions) p *= 2.0;
+  query.update_positions(mesh.positions);
+  EXPECT_NEAR(query.closest_point({0, 0, 3}).distance, 1.0, 1e-12);
+  const auto hit = query.intersect({0, 0, 5}, {0, 0, -1});
+  ASSERT_TRUE(hit.has_value());
+  EXPECT_NEAR(hit->distance, 3.0, 1e-6);
+}
+
+TEST(SurfaceQuery, RejectsNonFiniteAndEmptyInput) {
+  IndexedMesh mesh = test::octahedron();
+  mesh.positions[2].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(SurfaceQuery{mesh}, InputError);
+  EXPECT_THROW(SurfaceQuery(IndexedMesh{}), InputError);
+}
+
+}  // namespace
+}  // namespace mvflow

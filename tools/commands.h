@@ -1,0 +1,22 @@
+#pragma once
+// The subcommands of the `mvflow` program. Each registers its options on the CLI11 app and
+// returns the function that runs it; the function returns the process exit code.
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <memory>
+#include <spdlog/logger.h>
+
+namespace mvflow::cli {
+
+//! Exit codes: 0 ok, 1 bad input or failure, 2 bad usage.
+enum ExitCode : int { kOk = 0, kFailure = 1, kUsage = 2 };
+
+using Runner = std::function<int(spdlog::logger& log)>;
+
+//! `mvflow info SCENE [--mesh FILE] [--decode] [--json FILE]`
+void add_info_command(CLI::App& app, Runner& runner);
+//! `mvflow convert IN OUT [--ascii] [--to FORMAT]`
+void add_convert_command(CLI::App& app, Runner& runner);
+
+}  // namespace mvflow::cli
