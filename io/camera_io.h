@@ -1,7 +1,7 @@
 #pragma once
-// Camera files. Every reader returns views in file order with pixel coordinates converted to
-// mvflow's convention (SPEC §2: pixel (0,0) is the centre of the top-left pixel); every writer
-// converts back. Image sizes: Middlebury files carry none, so the reader leaves width/height 0
+// Camera files. Every reader returns views in file order (COLMAP: by IMAGE_ID) with pixel
+// coordinates converted to mvflow's convention (SPEC §2: pixel (0,0) is the centre of the
+// top-left pixel); every writer converts back. Image sizes: Middlebury files carry none, so the reader leaves width/height 0
 // unless told them (the scene loader fills them from the images).
 //
 // - Middlebury `*_par.txt`: first line the count, then per line
@@ -24,6 +24,7 @@ std::vector<View> read_middlebury(const std::filesystem::path& file, int width =
 void write_middlebury(const std::filesystem::path& file, const std::vector<View>& views);
 
 //! COLMAP: \p folder holds cameras.txt and images.txt (directly or in sparse/ or sparse/0/).
+//! Views are sorted by IMAGE_ID (COLMAP writes images.txt in no guaranteed order).
 std::vector<View> read_colmap(const std::filesystem::path& folder);
 //! Writes cameras.txt and images.txt into \p folder (one COLMAP camera per view; PINHOLE,
 //! SIMPLE_RADIAL, RADIAL or OPENCV chosen from the view's distortion). \throw InputError for a

@@ -80,8 +80,8 @@ const ModelInfo& find_model(const TextReader& reader, std::string_view name) {
 
 Intrinsics intrinsics_from(const ModelInfo& info, const std::vector<double>& p) {
   Intrinsics result;
-  const bool one_focal = info.model == Model::SimplePinhole || info.model == Model::SimpleRadial ||
-                         info.model == Model::Radial;
+  const bool one_focal =
+      info.model == Model::SimplePinhole || info.model == Model::SimpleRadial || info.model == Model::Radial;
   const std::size_t c = one_focal ? 1 : 2;  // index of cx
   result.K(0, 0) = p[0];
   result.K(1, 1) = one_focal ? p[0] : p[1];
@@ -108,12 +108,14 @@ Intrinsics intrinsics_from(const ModelInfo& info, const std::vector<double>& p) 
 std::pair<long long, Intrinsics> read_camera_line(const TextReader& reader) {
   const auto tokens = split_whitespace(reader.line());
   if (tokens.size() < 4)
-    reader.fail("expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS..., got " + std::to_string(tokens.size()) + " fields");
+    reader.fail("expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS..., got " + std::to_string(tokens.size()) +
+                " fields");
   const long long id = parse_integer(reader, tokens[0], "CAMERA_ID");
   const ModelInfo& info = find_model(reader, tokens[1]);
   if (tokens.size() != 4 + info.parameter_count)
     reader.fail("expected " + std::to_string(4 + info.parameter_count) + " fields for " + info.name +
-                ": CAMERA_ID MODEL WIDTH HEIGHT " + info.parameters + ", got " + std::to_string(tokens.size()));
+                ": CAMERA_ID MODEL WIDTH HEIGHT " + info.parameters + ", got " +
+                std::to_string(tokens.size()));
   std::vector<double> parameters;
   std::istringstream names(info.parameters);
   for (std::size_t i = 4; i < tokens.size(); ++i) {
@@ -155,7 +157,8 @@ Eigen::Matrix3d rotation_from_quaternion(const TextReader& reader, const Eigen::
 }
 
 // The image line at the reader's current line; the POINTS2D line is consumed by the caller.
-std::pair<long long, View> read_image_line(const TextReader& reader, const std::map<long long, Intrinsics>& cameras) {
+std::pair<long long, View> read_image_line(const TextReader& reader,
+                                           const std::map<long long, Intrinsics>& cameras) {
   const auto tokens = split_whitespace(reader.line());
   if (tokens.size() != 10)
     reader.fail("expected 10 fields: IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME (no spaces in NAME), got " +
@@ -165,7 +168,8 @@ std::pair<long long, View> read_image_line(const TextReader& reader, const std::
   Eigen::Vector3d t;
   constexpr std::array<const char*, 7> names{"QW", "QX", "QY", "QZ", "TX", "TY", "TZ"};
   for (int i = 0; i < 4; ++i) q[i] = parse_double(reader, tokens[1 + i], std::string("'") + names[i] + "'");
-  for (int i = 0; i < 3; ++i) t[i] = parse_double(reader, tokens[5 + i], std::string("'") + names[4 + i] + "'");
+  for (int i = 0; i < 3; ++i)
+    t[i] = parse_double(reader, tokens[5 + i], std::string("'") + names[4 + i] + "'");
   const long long camera_id = parse_integer(reader, tokens[8], "CAMERA_ID");
   const auto camera = cameras.find(camera_id);
   if (camera == cameras.end())
@@ -193,8 +197,9 @@ std::vector<View> read_images_txt(const fs::path& file, const std::map<long long
     images.push_back(std::move(image));
     // The POINTS2D line; COLMAP tolerates its absence after the last image, and so does this.
     if (reader.next_line() && split_whitespace(reader.line()).size() % 3 != 0)
-      reader.fail("expected the POINTS2D line (X Y POINT3D_ID triples, possibly empty) after the image line, got " +
-                  std::to_string(split_whitespace(reader.line()).size()) + " fields");
+      reader.fail(
+          "expected the POINTS2D line (X Y POINT3D_ID triples, possibly empty) after the image line, got " +
+          std::to_string(split_whitespace(reader.line()).size()) + " fields");
   }
   std::sort(images.begin(), images.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<View> views;
@@ -247,7 +252,8 @@ std::vector<double> colmap_parameters(Model model, const Camera& camera) {
     case Model::Radial:
       return {K(0, 0), cx, cy, k[0], k[1]};
     case Model::OpenCV:
-      if (camera.distortion().model == DistortionModel::Radial) return {K(0, 0), K(1, 1), cx, cy, k[0], k[1], 0, 0};
+      if (camera.distortion().model == DistortionModel::Radial)
+        return {K(0, 0), K(1, 1), cx, cy, k[0], k[1], 0, 0};
       return {K(0, 0), K(1, 1), cx, cy, k[0], k[1], k[2], k[3]};
   }
   return {};
@@ -255,15 +261,15 @@ std::vector<double> colmap_parameters(Model model, const Camera& camera) {
 
 void check_name(const fs::path& file, std::size_t index, const std::string& name) {
   if (name.empty() || name.find_first_of(" \t\r\n\f\v") != std::string::npos)
-    throw InputError(file, "camera", index, "COLMAP cannot represent an image name with whitespace, got '" + name + "'");
+    throw InputError(file, "camera", index,
+                     "COLMAP cannot represent an image name with whitespace, got '" + name + "'");
 }
 
 }  // namespace
 
 std::vector<View> read_colmap(const std::filesystem::path& folder) {
   const auto model = model_folder(folder);
-  if (!model)
-    throw IoError(folder, "no COLMAP cameras.txt and images.txt here, in sparse/ or in sparse/0/");
+  if (!model) throw IoError(folder, "no COLMAP cameras.txt and images.txt here, in sparse/ or in sparse/0/");
   return read_images_txt(*model / "images.txt", read_cameras_txt(*model / "cameras.txt"));
 }
 
@@ -291,7 +297,8 @@ void write_colmap(const std::filesystem::path& folder, const std::vector<View>& 
     cameras << '\n';
     Eigen::Quaterniond q(camera.R());
     if (q.w() < 0) q.coeffs() = -q.coeffs();  // the same rotation; one sign for reproducible files
-    images << id << ' ' << number(q.w()) << ' ' << number(q.x()) << ' ' << number(q.y()) << ' ' << number(q.z());
+    images << id << ' ' << number(q.w()) << ' ' << number(q.x()) << ' ' << number(q.y()) << ' '
+           << number(q.z());
     for (int k = 0; k < 3; ++k) images << ' ' << number(camera.t()(k));
     images << ' ' << id << ' ' << views[i].image_name << "\n\n";  // empty POINTS2D line
   }

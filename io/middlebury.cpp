@@ -47,8 +47,8 @@ std::size_t read_count(TextReader& reader) {
   reader.require_content_line("the number of cameras");
   const auto tokens = split_whitespace(reader.line());
   if (tokens.size() != 1)
-    reader.fail("expected the number of cameras alone on the first line, got " + std::to_string(tokens.size()) +
-                " fields");
+    reader.fail("expected the number of cameras alone on the first line, got " +
+                std::to_string(tokens.size()) + " fields");
   const long long count = parse_integer(reader, tokens[0], "the number of cameras");
   if (count == 0) reader.fail("expected a positive number of cameras, got 0");
   return static_cast<std::size_t>(count);
@@ -81,9 +81,9 @@ void check_representable(const std::filesystem::path& file, std::size_t index, c
   const auto& name = view.image_name;
   // A name starting with '#' would read back as a comment line.
   if (name.empty() || name.front() == '#' || name.find_first_of(" \t\r\n\f\v") != std::string::npos)
-    throw InputError(file, "camera", index,
-                     "Middlebury files need an image name without whitespace (not starting with '#'), got '" +
-                         name + "'");
+    throw InputError(
+        file, "camera", index,
+        "Middlebury files need an image name without whitespace (not starting with '#'), got '" + name + "'");
 }
 
 }  // namespace
@@ -96,9 +96,9 @@ std::vector<View> read_middlebury(const std::filesystem::path& file, int width, 
   views.reserve(std::min<std::size_t>(count, 4096));  // the count is untrusted input
   while (views.size() < count) {
     if (!reader.next_content_line())
-      throw InputError(file, reader.line_number() + 1,
-                       "expected " + std::to_string(count) + " cameras, file ends after " +
-                           std::to_string(views.size()));
+      throw InputError(
+          file, reader.line_number() + 1,
+          "expected " + std::to_string(count) + " cameras, file ends after " + std::to_string(views.size()));
     views.push_back(read_camera_line(reader, width, height));
   }
   if (reader.next_content_line())

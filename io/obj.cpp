@@ -1,6 +1,7 @@
 // Wavefront OBJ: positions (with optional vertex colours), texture coordinates, polygonal faces
 // and the diffuse texture named by the material library.
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -126,8 +127,17 @@ struct ObjReader {
     if (keyword == "v") read_vertex(t);
     else if (keyword == "vt") read_uv(t);
     else if (keyword == "f") read_face(t);
-    else if (keyword == "mtllib" && t.size() >= 2) material_libraries.emplace_back(t[t.size() - 1]);
+    else if (keyword == "mtllib" && t.size() >= 2) add_libraries(t);
     // vn, o, g, s, usemtl, l, p and anything else carry nothing mvflow uses.
+  }
+
+  //! "mtllib a.mtl b.mtl" lists libraries; a name with spaces is tried as a whole first.
+  void add_libraries(const std::vector<std::string_view>& t) {
+    const auto& line = reader.line();
+    const auto start = static_cast<std::size_t>(t[1].data() - line.data());
+    const auto end = static_cast<std::size_t>(t.back().data() + t.back().size() - line.data());
+    material_libraries.push_back(line.substr(start, end - start));
+    for (std::size_t k = 1; t.size() > 2 && k < t.size(); ++k) material_libraries.emplace_back(t[k]);
   }
 
   void check_references() const {
@@ -142,6 +152,28 @@ struct ObjReader {
   }
 };
 
+//! The file name of a `map_Kd` line: what follows its options ("-s 1 1 1", "-clamp on", ...),
+//! spaces included.
+std::string texture_name(std::string_view line) {
+  auto tokens = split_whitespace(line);
+  std::size_t i = 1;  // after map_Kd
+  while (i + 1 < tokens.size() && tokens[i].size() > 1 && tokens[i][0] == '-') {
+    const auto option = tokens[i++];
+    // -o, -s and -t take one to three numbers, -mm two, every other option one value.
+    const std::size_t most = (option == "-o" || option == "-s" || option == "-t") ? 3 : option == "-mm" ? 2 : 1;
+    for (std::size_t k = 0; k < most && i + 1 < tokens.size(); ++k) {
+      const bool number = std::isdigit(static_cast<unsigned char>(tokens[i][0])) || tokens[i][0] == '.' ||
+                          (tokens[i][0] == '-' && tokens[i].size() > 1 && !std::isalpha(static_cast<unsigned char>(tokens[i][1])));
+      if (k > 0 && !number) break;
+      ++i;
+    }
+  }
+  if (i >= tokens.size()) return {};
+  const auto start = static_cast<std::size_t>(tokens[i].data() - line.data());
+  const auto end = static_cast<std::size_t>(tokens.back().data() + tokens.back().size() - line.data());
+  return std::string(line.substr(start, end - start));
+}
+
 //! The first `map_Kd` of the material library beside the OBJ file, if the library exists.
 std::string diffuse_texture(const std::filesystem::path& obj, const std::string& library) {
   const auto path = obj.parent_path() / library;
@@ -149,7 +181,7 @@ std::string diffuse_texture(const std::filesystem::path& obj, const std::string&
   TextReader reader(path);
   while (reader.next_content_line('#')) {
     const auto t = split_whitespace(reader.line());
-    if (t.size() >= 2 && t[0] == "map_Kd") return std::string(t.back());  // options come before the name
+    if (t.size() >= 2 && t[0] == "map_Kd") return texture_name(reader.line());
   }
   return {};
 }

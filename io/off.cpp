@@ -38,11 +38,17 @@ OffLayout parse_keyword(const TextReader& reader, std::string_view keyword) {
   return layout;
 }
 
-//! Geomview: integer colour components are 0-255, real ones are already 0-1.
-float color_channel(const TextReader& reader, std::string_view token) {
-  const double value = parse_double(reader, token, "a vertex colour");
-  const bool integer = token.find_first_of(".eE") == std::string_view::npos;
-  return integer ? static_cast<float>(value) / 255.0f : static_cast<float>(value);
+//! Geomview: integer colours are 0-255, real ones already 0-1; a colour with any real component
+//! ("1.0 0.5 0") is real as a whole.
+Eigen::Vector3f read_color(const TextReader& reader, const std::vector<std::string_view>& tokens, std::size_t first) {
+  bool integer = true;
+  Eigen::Vector3f color;
+  for (int k = 0; k < 3; ++k) {
+    const auto token = tokens[first + k];
+    color[k] = static_cast<float>(parse_double(reader, token, "a vertex colour"));
+    integer = integer && token.find_first_of(".eE") == std::string_view::npos;
+  }
+  return integer ? Eigen::Vector3f(color / 255.0f) : color;
 }
 
 void read_vertex(const TextReader& reader, const OffLayout& layout, IndexedMesh& mesh) {
@@ -54,10 +60,7 @@ void read_vertex(const TextReader& reader, const OffLayout& layout, IndexedMesh&
   for (int k = 0; k < 3; ++k) p[k] = parse_double(reader, t[k], "a vertex coordinate");
   mesh.positions.push_back(p);
   if (!layout.colors) return;
-  const std::size_t first = layout.normals ? 6 : 3;
-  Eigen::Vector3f c;
-  for (int k = 0; k < 3; ++k) c[k] = color_channel(reader, t[first + k]);
-  mesh.colors.push_back(c);
+  mesh.colors.push_back(read_color(reader, t, layout.normals ? 6 : 3));
 }
 
 void read_face(const TextReader& reader, std::size_t face, std::size_t n_vertices, IndexedMesh& mesh) {

@@ -52,16 +52,22 @@ namespace mvflow::io {
 namespace {
 
 constexpr std::size_t field_count = 16;
+// clang-format off
 constexpr std::array<const char*, field_count> field_names{
-    "centerX",         "centerY",         "centerZ", "omega", "phi",        "kappa",
-    "pixelSizeX",      "pixelSizeY",      "focalLength",
-    "principalPointX", "principalPointY", "K1",      "K2",    "imageWidth", "imageHeight", "imageFile"};
+    "centerX", "centerY", "centerZ", "omega", "phi", "kappa",
+    "pixelSizeX", "pixelSizeY", "focalLength", "principalPointX", "principalPointY",
+    "K1", "K2", "imageWidth", "imageHeight", "imageFile"};
+// clang-format on
 
 // Assumed by the writer: the file needs a physical pixel size that a Camera does not carry.
 constexpr double written_pixel_size_mm = 0.005;
 
-constexpr double radians(double degrees) { return degrees * (std::numbers::pi / 180.0); }
-constexpr double degrees(double radians) { return radians * (180.0 / std::numbers::pi); }
+constexpr double radians(double degrees) {
+  return degrees * (std::numbers::pi / 180.0);
+}
+constexpr double degrees(double radians) {
+  return radians * (180.0 / std::numbers::pi);
+}
 
 std::string number(double value) {
   std::array<char, 32> buffer;
@@ -101,22 +107,25 @@ const Eigen::Matrix3d& flip_xy() {
 double parse_positive(const TextReader& reader, std::string_view token, std::size_t field) {
   const double value = parse_double(reader, token, std::string("'") + field_names[field] + "'");
   if (!(value > 0))
-    reader.fail(std::string("expected a positive ") + field_names[field] + " (mm), got '" + std::string(token) + "'");
+    reader.fail(std::string("expected a positive ") + field_names[field] + " (mm), got '" +
+                std::string(token) + "'");
   return value;
 }
 
 int parse_size(const TextReader& reader, std::string_view token, std::size_t field) {
   const long long value = parse_integer(reader, token, std::string("'") + field_names[field] + "'");
-  if (value > INT_MAX) reader.fail(std::string("expected an image size that fits in an int for ") + field_names[field]);
+  if (value > INT_MAX)
+    reader.fail(std::string("expected an image size that fits in an int for ") + field_names[field]);
   return static_cast<int>(value);
 }
 
 View read_camera_line(const TextReader& reader) {
   const auto tokens = split_whitespace(reader.line());
   if (tokens.size() < field_count)
-    reader.fail("expected 16 fields: centerX centerY centerZ omega phi kappa pixelSizeX pixelSizeY focalLength "
-                "principalPointX principalPointY K1 K2 imageWidth imageHeight imageFile, got " +
-                std::to_string(tokens.size()));
+    reader.fail(
+        "expected 16 fields: centerX centerY centerZ omega phi kappa pixelSizeX pixelSizeY focalLength "
+        "principalPointX principalPointY K1 K2 imageWidth imageHeight imageFile, got " +
+        std::to_string(tokens.size()));
   std::array<double, 13> v{};
   for (std::size_t i = 0; i < v.size(); ++i)
     v[i] = parse_double(reader, tokens[i], std::string("'") + field_names[i] + "'");
@@ -137,7 +146,8 @@ View read_camera_line(const TextReader& reader) {
   K(1, 1) = f / sy;
   K(0, 2) = v[9] / sx - 0.5;
   K(1, 2) = v[10] / sy - 0.5;
-  const Distortion distortion{DistortionModel::InverseRadial, {v[11] * f * f, v[12] * f * f * f * f, 0.0, 0.0}};
+  const Distortion distortion{DistortionModel::InverseRadial,
+                              {v[11] * f * f, v[12] * f * f * f * f, 0.0, 0.0}};
   try {
     return {Camera(K, R, -R * T, width, height, distortion), std::move(name)};
   } catch (const InputError& error) {
@@ -147,14 +157,15 @@ View read_camera_line(const TextReader& reader) {
 
 // The thesis's K1, K2 (mm⁻², mm⁻⁴) for a camera of focal length f mm; throws when the camera's
 // distortion is not the thesis's model.
-std::array<double, 2> thesis_distortion(const std::filesystem::path& file, std::size_t index, const Camera& camera,
-                                        double f) {
+std::array<double, 2> thesis_distortion(const std::filesystem::path& file, std::size_t index,
+                                        const Camera& camera, double f) {
   const Distortion& d = camera.distortion();
   if (d.is_identity()) return {0.0, 0.0};
   if (d.model != DistortionModel::InverseRadial)
-    throw InputError(file, "camera", index,
-                     "PhotoModeler-style files cannot represent this distortion model (only the inverse radial "
-                     "model of thesis eq. 2.6/2.7)");
+    throw InputError(
+        file, "camera", index,
+        "PhotoModeler-style files cannot represent this distortion model (only the inverse radial "
+        "model of thesis eq. 2.6/2.7)");
   return {d.coefficients[0] / (f * f), d.coefficients[1] / (f * f * f * f)};
 }
 
@@ -174,7 +185,8 @@ void check_representable(const std::filesystem::path& file, std::size_t index, c
                  name + "')");
 }
 
-void write_camera_line(std::ostream& out, const std::filesystem::path& file, std::size_t index, const View& view) {
+void write_camera_line(std::ostream& out, const std::filesystem::path& file, std::size_t index,
+                       const View& view) {
   const Camera& camera = view.camera;
   const Eigen::Matrix3d& K = camera.K();
   const double sx = written_pixel_size_mm;
@@ -183,9 +195,11 @@ void write_camera_line(std::ostream& out, const std::filesystem::path& file, std
   const auto [k1, k2] = thesis_distortion(file, index, camera, f);
   const Eigen::Vector3d angles = angles_from_rotation(flip_xy() * camera.R());
   const Eigen::Vector3d& T = camera.centre();
-  const std::array<double, 13> values{T.x(),   T.y(),  T.z(), degrees(angles[0]), degrees(angles[1]),
-                                      degrees(angles[2]), sx, sy, f, (K(0, 2) + 0.5) * sx,
-                                      (K(1, 2) + 0.5) * sy, k1, k2};
+  // clang-format off
+  const std::array<double, 13> values{
+      T.x(), T.y(), T.z(), degrees(angles[0]), degrees(angles[1]), degrees(angles[2]),
+      sx, sy, f, (K(0, 2) + 0.5) * sx, (K(1, 2) + 0.5) * sy, k1, k2};
+  // clang-format on
   for (double value : values) out << number(value) << ' ';
   out << camera.width() << ' ' << camera.height() << ' ' << view.image_name << '\n';
 }
@@ -200,6 +214,8 @@ std::vector<View> read_photomodeler(const std::filesystem::path& file) {
 }
 
 void write_photomodeler(const std::filesystem::path& file, const std::vector<View>& views) {
+  // Every camera is checked before the file is touched (thesis_distortion throws for a model
+  // the format lacks; its value is not needed here).
   for (std::size_t i = 0; i < views.size(); ++i) {
     check_representable(file, i, views[i]);
     thesis_distortion(file, i, views[i].camera, 1.0);

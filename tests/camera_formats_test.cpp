@@ -77,13 +77,15 @@ void expect_error(F&& action, const std::vector<std::string>& parts) {
     ADD_FAILURE() << "no exception thrown; expected one mentioning " << parts.front();
   } catch (const E& error) {
     const std::string what = error.what();
-    for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << "'" << what << "' lacks '" << part << "'";
+    for (const auto& part : parts)
+      EXPECT_NE(what.find(part), std::string::npos) << "'" << what << "' lacks '" << part << "'";
   }
 }
 
 // Points within 0.5 of the origin; the synthetic cameras below look at the origin from ~5 away.
 std::vector<Eigen::Vector3d> test_points() {
-  return {{0, 0, 0}, {0.3, -0.2, 0.1}, {-0.4, 0.25, -0.2}, {0.1, 0.45, 0.3}, {-0.35, -0.3, 0.35}, {0.2, 0.1, -0.45}};
+  return {{0, 0, 0},        {0.3, -0.2, 0.1},    {-0.4, 0.25, -0.2},
+          {0.1, 0.45, 0.3}, {-0.35, -0.3, 0.35}, {0.2, 0.1, -0.45}};
 }
 
 // World-to-camera rotation of a camera at \p centre looking at the origin, twisted about its axis.
@@ -136,10 +138,10 @@ std::string middlebury_line(const std::string& name, const Eigen::Matrix3d& K, c
                             const Eigen::Vector3d& t) {
   std::string line = name;
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) line += " " + g17(K(r, c));
+    for (int c = 0; c < 3; ++c) line.append(" ").append(g17(K(r, c)));
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) line += " " + g17(R(r, c));
-  for (int i = 0; i < 3; ++i) line += " " + g17(t(i));
+    for (int c = 0; c < 3; ++c) line.append(" ").append(g17(R(r, c)));
+  for (int i = 0; i < 3; ++i) line.append(" ").append(g17(t(i)));
   return line + "\n";
 }
 
@@ -221,7 +223,8 @@ TEST_F(CameraFormats, MiddleburyNearlyOrthonormalRotationIsRepaired) {
   write_text(dir_ / "near_par.txt", "1\n" + middlebury_line("a.png", c.K(), R, c.t()));
   const auto views = mvflow::io::read_middlebury(dir_ / "near_par.txt");
   ASSERT_EQ(views.size(), 1u);
-  EXPECT_TRUE((views[0].camera.R() * views[0].camera.R().transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+  EXPECT_TRUE(
+      (views[0].camera.R() * views[0].camera.R().transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
   EXPECT_TRUE(views[0].camera.R().isApprox(c.R(), 1e-5));
   R(0, 1) += 1e-2;
   write_text(dir_ / "far_par.txt", "1\n" + middlebury_line("a.png", c.K(), R, c.t()));
@@ -232,7 +235,8 @@ TEST_F(CameraFormats, MiddleburyNearlyOrthonormalRotationIsRepaired) {
 TEST_F(CameraFormats, MiddleburyRoundTripIsExact) {
   std::vector<View> views;
   for (int i = 0; i < 4; ++i)
-    views.push_back({synthetic_camera(i, 1234.5678 + i, 1230.1 - i, i * 0.25), "img" + std::to_string(i) + ".png"});
+    views.push_back(
+        {synthetic_camera(i, 1234.5678 + i, 1230.1 - i, i * 0.25), "img" + std::to_string(i) + ".png"});
   const fs::path file = dir_ / "out_par.txt";
   mvflow::io::write_middlebury(file, views);
   const auto back = mvflow::io::read_middlebury(file, 640, 480);
@@ -271,7 +275,7 @@ TEST_F(CameraFormats, MiddleburyBadInput) {
   expect_error<InputError>(read, {name, ":2:", "finite", "'t3'"});
   write_text(file, "1\n" + fields(4, "0.5"));
   expect_error<InputError>(read, {name, ":2:", "upper triangular"});
-  write_text(file, "1\n" + fields(10, "2") );
+  write_text(file, "1\n" + fields(10, "2"));
   expect_error<InputError>(read, {name, ":2:", "rotation"});
 
   write_text(file, "0\n");
@@ -293,8 +297,9 @@ TEST_F(CameraFormats, MiddleburyBadInput) {
 TEST_F(CameraFormats, MiddleburyUnrepresentableWriteLeavesFileUntouched) {
   const fs::path file = dir_ / "keep_par.txt";
   write_text(file, "previous content\n");
-  std::vector<View> views{{synthetic_camera(0, 800, 800, 0), "a.png"},
-                          {synthetic_camera(1, 800, 800, 0, {DistortionModel::Radial, {0.1, 0, 0, 0}}), "b.png"}};
+  std::vector<View> views{
+      {synthetic_camera(0, 800, 800, 0), "a.png"},
+      {synthetic_camera(1, 800, 800, 0, {DistortionModel::Radial, {0.1, 0, 0, 0}}), "b.png"}};
   expect_error<InputError>([&] { mvflow::io::write_middlebury(file, views); },
                            {file.string(), "camera 1", "distortion"});
   views[1] = {synthetic_camera(1, 800, 800, 0), "has space.png"};
@@ -312,7 +317,7 @@ Eigen::Matrix3d quaternion_matrix(double w, double x, double y, double z) {
   w /= n, x /= n, y /= n, z /= n;
   Eigen::Matrix3d R;
   R << 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),  //
-      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),  //
+      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),   //
       2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y);
   return R;
 }
@@ -375,10 +380,11 @@ std::vector<ColmapImage> colmap_images(std::size_t count) {
 void write_colmap_model(const fs::path& folder, const std::vector<ColmapCase>& cameras,
                         const std::vector<ColmapImage>& images) {
   fs::create_directories(folder);
-  std::string text = "# Camera list with one line of data per camera:\n#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
+  std::string text =
+      "# Camera list with one line of data per camera:\n#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     text += std::to_string(i + 1) + " " + cameras[i].model + " 640 480";
-    for (double p : cameras[i].params) text += " " + g17(p);
+    for (double p : cameras[i].params) text.append(" ").append(g17(p));
     text += "\n";
   }
   write_text(folder / "cameras.txt", text);
@@ -386,9 +392,13 @@ void write_colmap_model(const fs::path& folder, const std::vector<ColmapCase>& c
   for (std::size_t i = 0; i < images.size(); ++i) {
     const auto& im = images[i];
     text += std::to_string(i + 1);
-    for (double q : im.q) text += " " + g17(q);
-    for (int k = 0; k < 3; ++k) text += " " + g17(im.t(k));
-    text += " " + std::to_string(i % cameras.size() + 1) + " image" + std::to_string(i + 1) + ".jpg\n";
+    for (double q : im.q) text.append(" ").append(g17(q));
+    for (int k = 0; k < 3; ++k) text.append(" ").append(g17(im.t(k)));
+    text.append(" ")
+        .append(std::to_string(i % cameras.size() + 1))
+        .append(" image")
+        .append(std::to_string(i + 1))
+        .append(".jpg\n");
     // Alternate an empty POINTS2D line and one with observations.
     text += i % 2 ? "12.5 30.25 -1 100.0 200.0 7\n" : "\n";
   }
@@ -428,8 +438,8 @@ TEST_F(CameraFormats, ColmapFindsSparseFoldersAndSortsByImageId) {
   for (int id : {3, 1, 2}) {
     const auto& im = images[id - 1];
     text += std::to_string(id);
-    for (double q : im.q) text += " " + g17(q);
-    for (int k = 0; k < 3; ++k) text += " " + g17(im.t(k));
+    for (double q : im.q) text.append(" ").append(g17(q));
+    for (int k = 0; k < 3; ++k) text.append(" ").append(g17(im.t(k)));
     text += " 1 name" + std::to_string(id) + ".png\n\n";
     text += "# between records\n\n";
   }
@@ -452,8 +462,8 @@ TEST_F(CameraFormats, ColmapPointsLineIsAlwaysConsumed) {
   std::string text;
   for (int id : {1, 2}) {
     text += std::to_string(id);
-    for (double q : images[id - 1].q) text += " " + g17(q);
-    for (int k = 0; k < 3; ++k) text += " " + g17(images[id - 1].t(k));
+    for (double q : images[id - 1].q) text.append(" ").append(g17(q));
+    for (int k = 0; k < 3; ++k) text.append(" ").append(g17(images[id - 1].t(k)));
     text += " 1 v" + std::to_string(id) + ".png\n\n";
   }
   write_text(dir_ / "images.txt", text);
@@ -473,7 +483,8 @@ TEST_F(CameraFormats, ColmapRoundTripEveryModel) {
       {synthetic_camera(1, 990, 990, 0, {DistortionModel::Radial, {-0.1, 0, 0, 0}}), "simple_radial.png"},
       {synthetic_camera(2, 980, 980, 0, {DistortionModel::Radial, {-0.1, 0.03, 0, 0}}), "radial.png"},
       {synthetic_camera(3, 970, 975, 0, {DistortionModel::Radial, {-0.12, 0.02, 0, 0}}), "radial_fx_fy.png"},
-      {synthetic_camera(4, 960, 955, 0, {DistortionModel::OpenCV, {-0.2, 0.05, 0.001, -0.002}}), "opencv.png"},
+      {synthetic_camera(4, 960, 955, 0, {DistortionModel::OpenCV, {-0.2, 0.05, 0.001, -0.002}}),
+       "opencv.png"},
       {synthetic_camera(5, 950, 950, 0, {DistortionModel::Radial, {0, 0, 0, 0}}), "identity.png"},
   };
   const fs::path folder = dir_ / "model";
@@ -492,7 +503,8 @@ TEST_F(CameraFormats, ColmapRoundTripEveryModel) {
     std::string id, model;
     if (fields >> id >> model && id[0] != '#') chosen.push_back(model);
   }
-  EXPECT_EQ(chosen, (std::vector<std::string>{"PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "OPENCV", "PINHOLE"}));
+  EXPECT_EQ(chosen,
+            (std::vector<std::string>{"PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "OPENCV", "PINHOLE"}));
   const std::string images = read_text(folder / "images.txt");
   EXPECT_NE(images.find("# Image list with two lines of data per image:"), std::string::npos);
   EXPECT_NE(images.find(" 1 pinhole.png\n\n2 "), std::string::npos);  // empty POINTS2D lines
@@ -508,7 +520,8 @@ TEST_F(CameraFormats, ColmapReadModelsRoundTrip) {
 
 TEST_F(CameraFormats, CrossFormatMiddleburyColmapMiddlebury) {
   std::vector<View> views;
-  for (int i = 0; i < 3; ++i) views.push_back({synthetic_camera(i, 1500 + i, 1490 - i, 0), "v" + std::to_string(i) + ".png"});
+  for (int i = 0; i < 3; ++i)
+    views.push_back({synthetic_camera(i, 1500 + i, 1490 - i, 0), "v" + std::to_string(i) + ".png"});
   mvflow::io::write_middlebury(dir_ / "a_par.txt", views);
   const auto from_middlebury = mvflow::io::read_middlebury(dir_ / "a_par.txt", 640, 480);
   mvflow::io::write_colmap(dir_ / "colmap", from_middlebury);
@@ -528,7 +541,8 @@ TEST_F(CameraFormats, ColmapBadInput) {
   const std::string good_images = read_text(dir_ / "images.txt");
 
   write_text(dir_ / "cameras.txt", good_cameras + "9 FULL_OPENCV 640 480 1 1 1 1 0 0 0 0 0 0 0 0\n");
-  expect_error<InputError>(read, {cameras + ":8:", "unsupported camera model 'FULL_OPENCV'", "SIMPLE_RADIAL"});
+  expect_error<InputError>(read,
+                           {cameras + ":8:", "unsupported camera model 'FULL_OPENCV'", "SIMPLE_RADIAL"});
   write_text(dir_ / "cameras.txt", good_cameras + "9 PINHOLE 640 480 1 1 1\n");
   expect_error<InputError>(read, {cameras + ":8:", "expected 8 fields for PINHOLE"});
   write_text(dir_ / "cameras.txt", good_cameras + "9 PINHOLE 640 480 1 x 1 1\n");
@@ -585,10 +599,13 @@ TEST_F(CameraFormats, ColmapUnrepresentableWriteLeavesFilesUntouched) {
   fs::create_directories(folder);
   write_text(folder / "cameras.txt", "old cameras\n");
   write_text(folder / "images.txt", "old images\n");
-  std::vector<View> views{{synthetic_camera(0, 1000, 1000, 0), "a.png"}, {synthetic_camera(1, 1000, 1000, 2.5), "b.png"}};
-  expect_error<InputError>([&] { mvflow::io::write_colmap(folder, views); }, {"camera 1", "COLMAP cannot represent", "skew"});
+  std::vector<View> views{{synthetic_camera(0, 1000, 1000, 0), "a.png"},
+                          {synthetic_camera(1, 1000, 1000, 2.5), "b.png"}};
+  expect_error<InputError>([&] { mvflow::io::write_colmap(folder, views); },
+                           {"camera 1", "COLMAP cannot represent", "skew"});
   views[1] = {synthetic_camera(1, 1000, 1000, 0, {DistortionModel::InverseRadial, {0.1, 0, 0, 0}}), "b.png"};
-  expect_error<InputError>([&] { mvflow::io::write_colmap(folder, views); }, {"camera 1", "COLMAP cannot represent", "inverse radial"});
+  expect_error<InputError>([&] { mvflow::io::write_colmap(folder, views); },
+                           {"camera 1", "COLMAP cannot represent", "inverse radial"});
   views[1] = {synthetic_camera(1, 1000, 1000, 0), "b c.png"};
   expect_error<InputError>([&] { mvflow::io::write_colmap(folder, views); }, {"camera 1", "whitespace"});
   EXPECT_EQ(read_text(folder / "cameras.txt"), "old cameras\n");
@@ -609,7 +626,8 @@ struct PhotoRecord {
 
 std::string photo_line(const PhotoRecord& p) {
   std::string line;
-  for (double v : {p.center[0], p.center[1], p.center[2], p.omega, p.phi, p.kappa, p.sx, p.sy, p.f, p.ppx, p.ppy, p.k1, p.k2})
+  for (double v : {p.center[0], p.center[1], p.center[2], p.omega, p.phi, p.kappa, p.sx, p.sy, p.f, p.ppx,
+                   p.ppy, p.k1, p.k2})
     line += g17(v) + " ";
   return line + std::to_string(p.width) + " " + std::to_string(p.height) + " " + p.name + "\n";
 }
@@ -627,8 +645,34 @@ Eigen::Matrix3d thesis_rotation(double omega_deg, double phi_deg, double kappa_d
 
 std::vector<PhotoRecord> photo_records() {
   return {
-      {{2.5, -3.25, 10.0}, 12.5, -33.1, 101.7, 0.0064, 0.0065, 35.2, 12.1, 8.3, 2e-4, -3e-7, 3872, 2592, "IMG_0001.JPG"},
-      {{-4.0, 1.5, -2.0}, -170.25, 47.5, -20.0, 0.0071, 0.0071, 24.0, 10.9, 7.2, -4e-4, 6e-7, 3008, 2000, "photo two.jpg"},
+      {{2.5, -3.25, 10.0},
+       12.5,
+       -33.1,
+       101.7,
+       0.0064,
+       0.0065,
+       35.2,
+       12.1,
+       8.3,
+       2e-4,
+       -3e-7,
+       3872,
+       2592,
+       "IMG_0001.JPG"},
+      {{-4.0, 1.5, -2.0},
+       -170.25,
+       47.5,
+       -20.0,
+       0.0071,
+       0.0071,
+       24.0,
+       10.9,
+       7.2,
+       -4e-4,
+       6e-7,
+       3008,
+       2000,
+       "photo two.jpg"},
       {{0.1, 0.2, 0.3}, 0.0, 0.0, 0.0, 0.005, 0.005, 50.0, 8.0, 6.0, 0.0, 0.0, 0, 0, "plain.png"},
   };
 }
@@ -638,8 +682,9 @@ std::vector<Eigen::Vector3d> points_before(const PhotoRecord& p) {
   const Eigen::Matrix3d R = thesis_rotation(p.omega, p.phi, p.kappa);
   const Eigen::Vector3d T(p.center[0], p.center[1], p.center[2]);
   std::vector<Eigen::Vector3d> points;
-  for (const Eigen::Vector3d& Pc : {Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(1.2, -0.8, 6), Eigen::Vector3d(-1.5, 1.1, 7.5),
-                                   Eigen::Vector3d(0.4, 1.3, 4.5), Eigen::Vector3d(-0.9, -1.0, 3.9)})
+  for (const Eigen::Vector3d& Pc :
+       {Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(1.2, -0.8, 6), Eigen::Vector3d(-1.5, 1.1, 7.5),
+        Eigen::Vector3d(0.4, 1.3, 4.5), Eigen::Vector3d(-0.9, -1.0, 3.9)})
     points.push_back(T + R.transpose() * Pc);
   return points;
 }
@@ -662,7 +707,7 @@ TEST_F(CameraFormats, PhotoModelerProjectionFollowsThesisEquations) {
     // Principal point in pixels: mm from the image's top-left corner, which is pixel −0.5.
     const double ox = p.ppx / p.sx - 0.5, oy = p.ppy / p.sy - 0.5;
     for (const auto& Pw : points_before(p)) {
-      const Eigen::Vector3d Pc = R * (Pw - T);                    // (2.3)
+      const Eigen::Vector3d Pc = R * (Pw - T);                            // (2.3)
       const double x = p.f * Pc.x() / Pc.z(), y = p.f * Pc.y() / Pc.z();  // (2.1), (2.2)
       // (2.6), (2.7) give the true (x, y) from the observed (xd, yd): invert by fixed point.
       double xd = x, yd = y;
@@ -695,7 +740,8 @@ TEST_F(CameraFormats, PhotoModelerRoundTrip) {
     return dir_ / "in_pm.txt";
   }());
   // Plus synthetic cameras, one with inverse radial distortion, one at gimbal lock (phi = ±90°).
-  views.push_back({synthetic_camera(2, 1200, 1180, 0, {DistortionModel::InverseRadial, {0.08, -0.01, 0, 0}}), "syn.png"});
+  views.push_back(
+      {synthetic_camera(2, 1200, 1180, 0, {DistortionModel::InverseRadial, {0.08, -0.01, 0, 0}}), "syn.png"});
   {
     const Eigen::Vector3d T(0.3, -0.2, 6.0);
     const Eigen::Matrix3d R = Eigen::Vector3d(-1, -1, 1).asDiagonal() * thesis_rotation(25.0, 90.0, -40.0);
@@ -714,7 +760,8 @@ TEST_F(CameraFormats, PhotoModelerRoundTrip) {
     // Points in front of this camera: its centre plus a few metres along its viewing direction.
     const Camera& c = views[i].camera;
     const Eigen::Matrix3d Rt = c.R().transpose();
-    for (const Eigen::Vector3d& Pc : {Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(1, -0.7, 6), Eigen::Vector3d(-1.2, 0.9, 4)}) {
+    for (const Eigen::Vector3d& Pc :
+         {Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(1, -0.7, 6), Eigen::Vector3d(-1.2, 0.9, 4)}) {
       const Eigen::Vector3d X = c.centre() + Rt * Pc;
       const auto a = c.project(X), b = back[i].camera.project(X);
       EXPECT_NEAR(a.u, b.u, 1e-9 * std::max(1.0, std::abs(a.u)));
@@ -757,11 +804,14 @@ TEST_F(CameraFormats, PhotoModelerUnrepresentableWriteLeavesFileUntouched) {
   write_text(file, "old\n");
   const auto attempt = [&](const View& bad, const std::string& expected) {
     const std::vector<View> views{{synthetic_camera(0, 1000, 1000, 0), "ok.png"}, bad};
-    expect_error<InputError>([&] { mvflow::io::write_photomodeler(file, views); }, {file.string(), "camera 1", expected});
+    expect_error<InputError>([&] { mvflow::io::write_photomodeler(file, views); },
+                             {file.string(), "camera 1", expected});
   };
   attempt({synthetic_camera(1, 1000, 1000, 3.0), "b.png"}, "skew");
-  attempt({synthetic_camera(1, 1000, 1000, 0, {DistortionModel::OpenCV, {0.1, 0, 0.01, 0}}), "b.png"}, "distortion");
-  attempt({synthetic_camera(1, 1000, 1000, 0, {DistortionModel::Radial, {0.1, 0, 0, 0}}), "b.png"}, "distortion");
+  attempt({synthetic_camera(1, 1000, 1000, 0, {DistortionModel::OpenCV, {0.1, 0, 0.01, 0}}), "b.png"},
+          "distortion");
+  attempt({synthetic_camera(1, 1000, 1000, 0, {DistortionModel::Radial, {0.1, 0, 0, 0}}), "b.png"},
+          "distortion");
   attempt({synthetic_camera(1, 1000, 1000, 0), " padded.png"}, "whitespace");
   EXPECT_EQ(read_text(file), "old\n");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
@@ -775,9 +825,11 @@ TEST_F(CameraFormats, FormatNamesAndDispatch) {
     EXPECT_EQ(mvflow::io::camera_format_from_name(mvflow::io::camera_format_name(format)), format);
   expect_error<InputError>([] { mvflow::io::camera_format_from_name("bundler"); }, {"bundler", "middlebury"});
 
-  const std::vector<View> views{{synthetic_camera(0, 900, 900, 0), "a.png"}, {synthetic_camera(1, 910, 905, 0), "b.png"}};
+  const std::vector<View> views{{synthetic_camera(0, 900, 900, 0), "a.png"},
+                                {synthetic_camera(1, 910, 905, 0), "b.png"}};
   const std::vector<std::pair<CameraFormat, fs::path>> targets{
-      {CameraFormat::Middlebury, dir_ / "x_par.txt"}, {CameraFormat::Colmap, dir_ / "colmap"},
+      {CameraFormat::Middlebury, dir_ / "x_par.txt"},
+      {CameraFormat::Colmap, dir_ / "colmap"},
       {CameraFormat::PhotoModeler, dir_ / "x_pm.txt"}};
   for (const auto& [format, path] : targets) {
     SCOPED_TRACE(mvflow::io::camera_format_name(format));

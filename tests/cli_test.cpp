@@ -54,7 +54,7 @@ TEST(Cli, InfoDescribesTheDefaultScene) {
   EXPECT_NE(r.output.find("cameras    4 (middlebury"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("4 × 80x60"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("6 vertices, 8 faces, 12 edges"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("genus 0"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("total genus 0"), std::string::npos) << r.output;
   const std::string json = test::read_text(folder / "info.json");
   EXPECT_NE(json.find("\"coverage\""), std::string::npos);
   // The 4 ring cameras all see the box centre.
@@ -68,6 +68,28 @@ TEST(Cli, BadInputExitsOneNamingTheFile) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("broken_par.txt:2"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("terminate"), std::string::npos) << r.output;
+}
+
+TEST(Cli, NonManifoldMeshIsReportedNotFatal) {
+  test::ScratchFolder folder;
+  // Three triangles on the edge (0,1).
+  test::write_text(folder / "fan.off", "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n");
+  const CommandResult r = run("info " + kDefaultScene.string() + " --mesh " + (folder / "fan.off").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 face(s) skipped as non-manifold"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fan.off: 1 face(s) would make the mesh non-manifold"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BadMeshExitsOneNamingFileAndLine) {
+  test::ScratchFolder folder;
+  test::write_text(folder / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 x 0\nf 1 2 3\n");
+  const CommandResult r = run("info " + kDefaultScene.string() + " --mesh " + (folder / "bad.obj").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("bad.obj:3"), std::string::npos) << r.output;
+  // Converting it fails too, and leaves an existing output untouched.
+  test::write_text(folder / "out.ply", "keep");
+  EXPECT_EQ(run("convert " + (folder / "bad.obj").string() + " " + (folder / "out.ply").string()).exit_code, 1);
+  EXPECT_EQ(test::read_text(folder / "out.ply"), "keep");
 }
 
 TEST(Cli, ConvertMeshAndCamerasRoundTrip) {

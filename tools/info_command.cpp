@@ -65,7 +65,8 @@ nlohmann::json mesh_summary(const std::string& file, const Mesh& mesh, const Mes
           {"isolated_vertices", s.isolated_vertices},
           {"components", s.components},
           {"euler_characteristic", s.euler_characteristic},
-          {"genus", s.genus},
+          // Euler's formula assumes a manifold surface; elsewhere the genus means nothing.
+          {"genus", s.is_manifold() ? nlohmann::json(s.genus) : nlohmann::json(nullptr)},
           {"shortest_edge", s.shortest_edge},
           {"longest_edge", s.longest_edge},
           {"mean_edge", s.mean_edge},
@@ -114,8 +115,9 @@ void print_text(const nlohmann::json& info, int grid) {
     fmt::print("mesh       {}\n", m["file"].get<std::string>());
     fmt::print("  size     {} vertices, {} faces, {} edges\n", m["vertices"].get<long>(), m["faces"].get<long>(),
                m["edges"].get<long>());
-    fmt::print("  topology {} component(s), genus {}, Euler characteristic {}, {} boundary edge(s) in {} loop(s)\n",
-               m["components"].get<long>(), m["genus"].get<long>(), m["euler_characteristic"].get<long>(),
+    const std::string genus = m["genus"].is_null() ? "n/a (non-manifold)" : std::to_string(m["genus"].get<long>());
+    fmt::print("  topology {} component(s), total genus {}, Euler characteristic {}, {} boundary edge(s) in {} loop(s)\n",
+               m["components"].get<long>(), genus, m["euler_characteristic"].get<long>(),
                m["boundary_edges"].get<long>(), m["boundary_loops"].get<long>());
     fmt::print("  manifold {} non-manifold vertex(es), {} face(s) skipped as non-manifold, {} isolated vertex(es)\n",
                m["non_manifold_vertices"].get<long>(), m["non_manifold_faces_skipped"].get<long>(),
