@@ -40,8 +40,7 @@ Mesh build_mesh(const IndexedMesh& indexed, const std::string& source, MeshBuild
   for (const auto& p : indexed.positions) m.add_vertex(to_openmesh(p));
 
   // OpenMesh reports a complex edge or vertex on omerr; we report it ourselves instead.
-  const bool omerr_was_enabled = omerr().is_enabled();
-  omerr().disable();
+  const QuietOpenMesh quiet;
   MeshBuildReport local;
   for (std::size_t f = 0; f < indexed.triangles.size(); ++f) {
     const auto& t = indexed.triangles[f];
@@ -65,7 +64,6 @@ Mesh build_mesh(const IndexedMesh& indexed, const std::string& source, MeshBuild
       }
     }
   }
-  if (omerr_was_enabled) omerr().enable();
 
   mesh.colors = indexed.colors;
   mesh.quality = indexed.quality;
@@ -75,22 +73,46 @@ Mesh build_mesh(const IndexedMesh& indexed, const std::string& source, MeshBuild
 }
 
 IndexedMesh to_indexed(const Mesh& mesh) {
-  const TriMesh& m = mesh.topology;
   IndexedMesh out;
-  out.positions.reserve(m.n_vertices());
-  for (auto v : m.vertices()) out.positions.push_back(to_eigen(m.point(v)));
-  out.triangles.reserve(m.n_faces());
-  for (auto f : m.faces()) {
-    std::array<std::uint32_t, 3> t{};
-    int c = 0;
-    for (auto v : m.fv_range(f)) t[c++] = static_cast<std::uint32_t>(v.idx());
-    out.triangles.push_back(t);
-  }
+  out.positions = positions_of(mesh.topology);
+  out.triangles = triangles_of(mesh.topology);
   out.colors = mesh.colors;
   out.quality = mesh.quality;
   out.texcoords = mesh.texcoords;
   out.texture_file = mesh.texture_file;
   return out;
+}
+
+std::vector<Eigen::Vector3d> positions_of(const TriMesh& mesh) {
+  std::vector<Eigen::Vector3d> positions;
+  positions.reserve(mesh.n_vertices());
+  for (auto v : mesh.vertices()) positions.push_back(to_eigen(mesh.point(v)));
+  return positions;
+}
+
+std::vector<std::array<std::uint32_t, 3>> triangles_of(const TriMesh& mesh) {
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  triangles.reserve(mesh.n_faces());
+  for (auto f : mesh.faces()) {
+    std::array<std::uint32_t, 3> t{};
+    int corner = 0;
+    for (auto v : mesh.fv_range(f)) t[corner++] = static_cast<std::uint32_t>(v.idx());
+    triangles.push_back(t);
+  }
+  return triangles;
+}
+
+QuietOpenMesh::QuietOpenMesh()
+    : err_(omerr().is_enabled()), log_(omlog().is_enabled()), out_(omout().is_enabled()) {
+  omerr().disable();
+  omlog().disable();
+  omout().disable();
+}
+
+QuietOpenMesh::~QuietOpenMesh() {
+  if (err_) omerr().enable();
+  if (log_) omlog().enable();
+  if (out_) omout().enable();
 }
 
 }  // namespace mvflow

@@ -67,4 +67,22 @@ Mesh build_mesh(const IndexedMesh& indexed, const std::string& source, MeshBuild
 //! The flat form of \p mesh (vertex ids and face ids kept).
 IndexedMesh to_indexed(const Mesh& mesh);
 
+//! Vertex positions of \p mesh, #V, in vertex-id order.
+std::vector<Eigen::Vector3d> positions_of(const TriMesh& mesh);
+//! Triangles of \p mesh, #F, in face-id order, corners in OpenMesh's face-vertex order.
+std::vector<std::array<std::uint32_t, 3>> triangles_of(const TriMesh& mesh);
+
+//! Keeps OpenMesh's console messages (omerr, omlog, omout) quiet while it lives: mvflow reports
+//! problems itself, with the file and element named. Not thread-safe (OpenMesh's streams are global).
+class QuietOpenMesh {
+ public:
+  QuietOpenMesh();
+  ~QuietOpenMesh();
+  QuietOpenMesh(const QuietOpenMesh&) = delete;
+  QuietOpenMesh& operator=(const QuietOpenMesh&) = delete;
+
+ private:
+  bool err_, log_, out_;
+};
+
 }  // namespace mvflow

@@ -13,25 +13,6 @@ namespace mvflow {
 
 namespace {
 
-std::vector<Eigen::Vector3d> positions_of(const TriMesh& mesh) {
-  std::vector<Eigen::Vector3d> positions;
-  positions.reserve(mesh.n_vertices());
-  for (auto v : mesh.vertices()) positions.push_back(to_eigen(mesh.point(v)));
-  return positions;
-}
-
-std::vector<std::array<std::uint32_t, 3>> triangles_of(const TriMesh& mesh) {
-  std::vector<std::array<std::uint32_t, 3>> triangles;
-  triangles.reserve(mesh.n_faces());
-  for (auto f : mesh.faces()) {
-    std::array<std::uint32_t, 3> t{};
-    int corner = 0;
-    for (auto v : mesh.fv_range(f)) t[corner++] = static_cast<std::uint32_t>(v.idx());
-    triangles.push_back(t);
-  }
-  return triangles;
-}
-
 // Embree reports errors through a callback; we keep the last message and throw from the caller.
 struct DeviceErrors {
   std::mutex mutex;

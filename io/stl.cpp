@@ -13,40 +13,6 @@ namespace mvflow::io {
 
 namespace {
 
-//! Keeps OpenMesh's own messages off the console for the lifetime of the object.
-class QuietOpenMesh {
- public:
-  QuietOpenMesh() : err_(omerr().is_enabled()), log_(omlog().is_enabled()), out_(omout().is_enabled()) {
-    omerr().disable();
-    omlog().disable();
-    omout().disable();
-  }
-  ~QuietOpenMesh() {
-    if (err_) omerr().enable();
-    if (log_) omlog().enable();
-    if (out_) omout().enable();
-  }
-  QuietOpenMesh(const QuietOpenMesh&) = delete;
-  QuietOpenMesh& operator=(const QuietOpenMesh&) = delete;
-
- private:
-  bool err_, log_, out_;
-};
-
-IndexedMesh from_openmesh(const TriMesh& m) {
-  IndexedMesh mesh;
-  mesh.positions.reserve(m.n_vertices());
-  for (auto v : m.vertices()) mesh.positions.push_back(to_eigen(m.point(v)));
-  mesh.triangles.reserve(m.n_faces());
-  for (auto f : m.faces()) {
-    std::array<std::uint32_t, 3> t{};
-    int c = 0;
-    for (auto v : m.fv_range(f)) t[c++] = static_cast<std::uint32_t>(v.idx());
-    mesh.triangles.push_back(t);
-  }
-  return mesh;
-}
-
 //! Every triangle with its own three vertices: STL has no shared vertices anyway, and this way
 //! OpenMesh cannot drop a non-manifold or degenerate triangle while building its mesh.
 TriMesh to_triangle_soup(const IndexedMesh& mesh) {
@@ -77,7 +43,9 @@ IndexedMesh read_stl(const std::filesystem::path& file) {
   }
   if (!ok) throw InputError(file, 0, "expected an ASCII or binary STL file (OpenMesh could not read it)");
   if (m.n_faces() == 0) throw InputError(file, 0, "expected at least one triangle, the STL file has none");
-  IndexedMesh mesh = from_openmesh(m);
+  IndexedMesh mesh;
+  mesh.positions = positions_of(m);
+  mesh.triangles = triangles_of(m);
   mesh.validate(file.string());  // finite coordinates
   return mesh;
 }
