@@ -20,6 +20,7 @@
 
 #include "engine/error.h"
 #include "io/atomic_write.h"
+#include "io/number_text.h"
 #include "io/camera_io.h"
 #include "io/text_reader.h"
 
@@ -58,12 +59,6 @@ struct Intrinsics {
   int width = 0;
   int height = 0;
 };
-
-std::string number(double value) {
-  std::array<char, 32> buffer;
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return std::string(buffer.data(), result.ptr);
-}
 
 int parse_size(const TextReader& reader, std::string_view token, const std::string& what) {
   const long long value = parse_integer(reader, token, what);
@@ -152,7 +147,7 @@ std::map<long long, Intrinsics> read_cameras_txt(const fs::path& file) {
 Eigen::Matrix3d rotation_from_quaternion(const TextReader& reader, const Eigen::Vector4d& wxyz) {
   const double norm = wxyz.norm();
   if (norm == 0 || std::abs(norm - 1) > 1e-3)
-    reader.fail("expected a unit quaternion QW QX QY QZ, got one of norm " + number(norm));
+    reader.fail("expected a unit quaternion QW QX QY QZ, got one of norm " + format_number(norm));
   return Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized().toRotationMatrix();
 }
 
@@ -220,7 +215,7 @@ Model choose_model(const fs::path& file, std::size_t index, const Camera& camera
   const auto cannot = [&](const std::string& what) {
     return InputError(file, "camera", index, "COLMAP cannot represent " + what);
   };
-  if (camera.K()(0, 1) != 0) throw cannot("a skewed camera (K12 = " + number(camera.K()(0, 1)) + ")");
+  if (camera.K()(0, 1) != 0) throw cannot("a skewed camera (K12 = " + format_number(camera.K()(0, 1)) + ")");
   const Distortion& d = camera.distortion();
   if (d.is_identity()) return Model::Pinhole;
   const bool square = camera.K()(0, 0) == camera.K()(1, 1);
@@ -293,13 +288,13 @@ void write_colmap(const std::filesystem::path& folder, const std::vector<View>& 
     const std::size_t id = i + 1;
     // An unknown size (0) is written as 0: mvflow reads it back as unknown; COLMAP itself needs it.
     cameras << id << ' ' << model_info(chosen[i]).name << ' ' << camera.width() << ' ' << camera.height();
-    for (double p : colmap_parameters(chosen[i], camera)) cameras << ' ' << number(p);
+    for (double p : colmap_parameters(chosen[i], camera)) cameras << ' ' << format_number(p);
     cameras << '\n';
     Eigen::Quaterniond q(camera.R());
     if (q.w() < 0) q.coeffs() = -q.coeffs();  // the same rotation; one sign for reproducible files
-    images << id << ' ' << number(q.w()) << ' ' << number(q.x()) << ' ' << number(q.y()) << ' '
-           << number(q.z());
-    for (int k = 0; k < 3; ++k) images << ' ' << number(camera.t()(k));
+    images << id << ' ' << format_number(q.w()) << ' ' << format_number(q.x()) << ' ' << format_number(q.y()) << ' '
+           << format_number(q.z());
+    for (int k = 0; k < 3; ++k) images << ' ' << format_number(camera.t()(k));
     images << ' ' << id << ' ' << views[i].image_name << "\n\n";  // empty POINTS2D line
   }
   std::error_code error;

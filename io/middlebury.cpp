@@ -12,6 +12,7 @@
 
 #include "engine/error.h"
 #include "io/atomic_write.h"
+#include "io/number_text.h"
 #include "io/camera_io.h"
 #include "io/text_reader.h"
 
@@ -23,13 +24,6 @@ constexpr std::size_t field_count = 22;
 constexpr std::array<const char*, field_count> field_names{
     "name", "k11", "k12", "k13", "k21", "k22", "k23", "k31", "k32", "k33", "r11",
     "r12",  "r13", "r21", "r22", "r23", "r31", "r32", "r33", "t1",  "t2",  "t3"};
-
-// Shortest text that reads back to the same double, so write → read round trips are exact.
-std::string number(double value) {
-  std::array<char, 32> buffer;
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return std::string(buffer.data(), result.ptr);
-}
 
 // The published files give R with ~17 digits but only approximately orthonormal
 // (dinoSR_par.txt: ‖RRᵀ − I‖ ≈ 2e-6, beyond Camera's 1e-6 tolerance). A deviation up to 1e-4 is
@@ -114,10 +108,10 @@ void write_middlebury(const std::filesystem::path& file, const std::vector<View>
       const Camera& camera = view.camera;
       out << view.image_name;
       for (int row = 0; row < 3; ++row)
-        for (int col = 0; col < 3; ++col) out << ' ' << number(camera.K()(row, col));
+        for (int col = 0; col < 3; ++col) out << ' ' << format_number(camera.K()(row, col));
       for (int row = 0; row < 3; ++row)
-        for (int col = 0; col < 3; ++col) out << ' ' << number(camera.R()(row, col));
-      for (int i = 0; i < 3; ++i) out << ' ' << number(camera.t()(i));
+        for (int col = 0; col < 3; ++col) out << ' ' << format_number(camera.R()(row, col));
+      for (int i = 0; i < 3; ++i) out << ' ' << format_number(camera.t()(i));
       out << '\n';
     }
   });

@@ -9,6 +9,7 @@
 
 #include "engine/error.h"
 #include "io/atomic_write.h"
+#include "io/number_text.h"
 #include "io/mesh_io.h"
 #include "io/text_reader.h"
 
@@ -186,13 +187,6 @@ std::string diffuse_texture(const std::filesystem::path& obj, const std::string&
   return {};
 }
 
-template <typename T>
-void put_number(std::string& line, T value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);  // shortest round-trip form
-  line.append(buffer, result.ptr);
-}
-
 void put_obj(std::ostream& out, const IndexedMesh& mesh, const MeshWriteOptions& options, const std::string& library) {
   const bool colors = options.write_colors && mesh.has_colors();
   const bool uvs = options.write_texcoords && mesh.has_texcoords();
@@ -202,9 +196,9 @@ void put_obj(std::ostream& out, const IndexedMesh& mesh, const MeshWriteOptions&
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
     line.clear();
     line.push_back('v');
-    for (int k = 0; k < 3; ++k) put_number(line.append(" "), mesh.positions[v][k]);
+    for (int k = 0; k < 3; ++k) append_number(line.append(" "), mesh.positions[v][k]);
     if (colors)
-      for (int k = 0; k < 3; ++k) put_number(line.append(" "), mesh.colors[v][k]);
+      for (int k = 0; k < 3; ++k) append_number(line.append(" "), mesh.colors[v][k]);
     out << line << '\n';
   }
   if (uvs)
@@ -212,7 +206,7 @@ void put_obj(std::ostream& out, const IndexedMesh& mesh, const MeshWriteOptions&
       line.clear();
       line.push_back('v');
       line.push_back('t');
-      for (int k = 0; k < 2; ++k) put_number(line.append(" "), uv[k]);
+      for (int k = 0; k < 2; ++k) append_number(line.append(" "), uv[k]);
       out << line << '\n';
     }
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {

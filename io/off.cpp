@@ -7,6 +7,7 @@
 
 #include "engine/error.h"
 #include "io/atomic_write.h"
+#include "io/number_text.h"
 #include "io/mesh_io.h"
 #include "io/text_reader.h"
 
@@ -87,13 +88,6 @@ void read_face(const TextReader& reader, std::size_t face, std::size_t n_vertice
                    "expected " + std::to_string(expected) + " " + what + ", file ends after " + std::to_string(got));
 }
 
-template <typename T>
-void put_number(std::string& line, T value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);  // shortest round-trip form
-  line.append(buffer, result.ptr);
-}
-
 int to_byte(float channel) {
   const float clamped = std::clamp(std::isfinite(channel) ? channel : 0.0f, 0.0f, 1.0f);
   return static_cast<int>(std::lround(clamped * 255.0f));
@@ -104,7 +98,7 @@ void put_off(std::ostream& out, const IndexedMesh& mesh, bool colors) {
   std::string line;
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
     line.clear();
-    for (int k = 0; k < 3; ++k) put_number(k > 0 ? line.append(" ") : line, mesh.positions[v][k]);
+    for (int k = 0; k < 3; ++k) append_number(k > 0 ? line.append(" ") : line, mesh.positions[v][k]);
     // Integer 0-255 colours (with opaque alpha), the form every OFF reader understands.
     if (colors)
       for (int k = 0; k < 4; ++k) line.append(" ").append(std::to_string(k < 3 ? to_byte(mesh.colors[v][k]) : 255));

@@ -44,6 +44,7 @@
 
 #include "engine/error.h"
 #include "io/atomic_write.h"
+#include "io/number_text.h"
 #include "io/camera_io.h"
 #include "io/text_reader.h"
 
@@ -67,12 +68,6 @@ constexpr double radians(double degrees) {
 }
 constexpr double degrees(double radians) {
   return radians * (180.0 / std::numbers::pi);
-}
-
-std::string number(double value) {
-  std::array<char, 32> buffer;
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return std::string(buffer.data(), result.ptr);
 }
 
 // R = Rκ·Rφ·Rω, the passive photogrammetric rotations (thesis eq. 2.3, [1]).
@@ -174,7 +169,7 @@ void check_representable(const std::filesystem::path& file, std::size_t index, c
   const auto cannot = [&](const std::string& what) {
     return InputError(file, "camera", index, "PhotoModeler-style files cannot represent " + what);
   };
-  if (K(0, 1) != 0) throw cannot("a skewed camera (K12 = " + number(K(0, 1)) + ")");
+  if (K(0, 1) != 0) throw cannot("a skewed camera (K12 = " + format_number(K(0, 1)) + ")");
   if (!(K(0, 0) > 0 && K(1, 1) > 0)) throw cannot("a negative focal length");
   const auto& name = view.image_name;
   const bool padded = !name.empty() && (std::isspace(static_cast<unsigned char>(name.front())) ||
@@ -200,7 +195,7 @@ void write_camera_line(std::ostream& out, const std::filesystem::path& file, std
       T.x(), T.y(), T.z(), degrees(angles[0]), degrees(angles[1]), degrees(angles[2]),
       sx, sy, f, (K(0, 2) + 0.5) * sx, (K(1, 2) + 0.5) * sy, k1, k2};
   // clang-format on
-  for (double value : values) out << number(value) << ' ';
+  for (double value : values) out << format_number(value) << ' ';
   out << camera.width() << ' ' << camera.height() << ' ' << view.image_name << '\n';
 }
 

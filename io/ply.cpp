@@ -12,6 +12,7 @@
 
 #include "engine/error.h"
 #include "io/atomic_write.h"
+#include "io/number_text.h"
 #include "io/mesh_io.h"
 #include "io/text_reader.h"
 
@@ -466,13 +467,6 @@ std::uint8_t to_byte(float channel) {
 }
 
 template <typename T>
-void put_number(std::string& line, T value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);  // shortest round-trip form
-  line.append(buffer, result.ptr);
-}
-
-template <typename T>
 void put_binary(std::string& data, T value) {
   static_assert(std::is_arithmetic_v<T>);
   char bytes[sizeof(T)];
@@ -488,13 +482,13 @@ void put_ascii_body(std::ostream& out, const IndexedMesh& mesh, bool colors, boo
     const auto& p = mesh.positions[v];
     for (int k = 0; k < 3; ++k) {
       if (k > 0) line += ' ';
-      put_number(line, p[k]);
+      append_number(line, p[k]);
     }
     if (colors)
       for (int k = 0; k < 3; ++k) line.append(" ").append(std::to_string(to_byte(mesh.colors[v][k])));
     if (quality) {
       line += ' ';
-      put_number(line, mesh.quality[v]);
+      append_number(line, mesh.quality[v]);
     }
     line += '\n';
     out << line;

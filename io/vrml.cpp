@@ -14,6 +14,7 @@
 
 #include "engine/error.h"
 #include "io/atomic_write.h"
+#include "io/number_text.h"
 #include "io/mesh_io.h"
 
 namespace mvflow::io {
@@ -529,13 +530,6 @@ std::string read_file(const std::filesystem::path& file) {
   return content.str();
 }
 
-template <typename T>
-void put_number(std::string& line, T value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);  // shortest round-trip form
-  line.append(buffer, result.ptr);
-}
-
 std::string quoted(const std::string& text) {
   std::string out = "\"";
   for (char c : text) {
@@ -554,7 +548,7 @@ void put_vrml(std::ostream& out, const IndexedMesh& mesh, const MeshWriteOptions
   std::string line;
   for (const auto& p : mesh.positions) {
     line.assign(8, ' ');
-    for (int k = 0; k < 3; ++k) put_number(k > 0 ? line.append(" ") : line, p[k]);
+    for (int k = 0; k < 3; ++k) append_number(k > 0 ? line.append(" ") : line, p[k]);
     out << line << ",\n";
   }
   out << "      ]\n    }\n    coordIndex [\n";
@@ -564,8 +558,8 @@ void put_vrml(std::ostream& out, const IndexedMesh& mesh, const MeshWriteOptions
     out << "    texCoord TextureCoordinate {\n      point [\n";
     for (const auto& uv : mesh.texcoords) {
       line.assign(8, ' ');
-      put_number(line, uv[0]);
-      put_number(line.append(" "), uv[1]);
+      append_number(line, uv[0]);
+      append_number(line.append(" "), uv[1]);
       out << line << ",\n";
     }
     out << "      ]\n    }\n    texCoordIndex [\n";
