@@ -10,6 +10,7 @@ void VertexFields::resize(std::size_t n_vertices, std::size_t n_views) {
   MVFLOW_CHECK(n_views <= 65535, "at most 65535 views are supported");
   normal.assign(n_vertices, Eigen::Vector3d::Zero());
   mean_curvature.assign(n_vertices, 0.0);
+  curvature_normal_length.assign(n_vertices, 0.0);
   photo_consistency.assign(n_vertices, 0.0);
   photo_gradient.assign(n_vertices, Eigen::Vector3d::Zero());
   speed.assign(n_vertices, Eigen::Vector3d::Zero());

@@ -23,6 +23,10 @@ enum VertexDefined : std::uint8_t {
 struct VertexFields {
   std::vector<Eigen::Vector3d> normal;       //!< outward unit normal N
   std::vector<double> mean_curvature;        //!< H (1/r on a sphere of radius r)
+  //! |Σ_j c_j (Q_j − P)| / 2, the unnormalized mean-curvature-normal length (cotangent weights,
+  //! no area division) that adaptive refinement compares with e_S/2 (SPEC §5); valid where
+  //! kCurvatureDefined is set, 0 elsewhere.
+  std::vector<double> curvature_normal_length;
   std::vector<double> photo_consistency;     //!< g
   std::vector<Eigen::Vector3d> photo_gradient;  //!< ∇g
   std::vector<Eigen::Vector3d> speed;        //!< F

@@ -19,6 +19,9 @@ void add_info_command(CLI::App& app, Runner& runner);
 //! `mvflow convert IN OUT [--ascii] [--to FORMAT]`
 void add_convert_command(CLI::App& app, Runner& runner);
 
+//! `mvflow synth [--preset NAME] [options] -o DIR`
+void add_synth_command(CLI::App& app, Runner& runner);
+
 //! `mvflow eval MESH TRUTH [--json FILE] [--samples N] [--threshold F]`
 void add_eval_command(CLI::App& app, Runner& runner);
 

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   Runner runner;
   add_info_command(app, runner);
   add_convert_command(app, runner);
+  add_eval_command(app, runner);
+  add_synth_command(app, runner);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,41 @@
+#pragma once
+// Photo consistency g (SPEC §3; thesis eq. 4.14, §5.3.3, figure 5.3b): project a point into
+// each of its views, take the (2h+1)×(2h+1) patch around the projection (bilinear), and sum the
+// unbiased variance across views over channels and patch offsets, averaged over the offsets:
+//   var_{c,o} = (Σ_i C_i² − (Σ_i C_i)²/m) / (m − 1),   g = Σ_c (1/(2h+1)²) Σ_o var_{c,o}.
+// g ≥ 0, 0 when all views agree; undefined with fewer than 2 usable views (a view whose patch
+// would leave its image does not count for that point).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "engine/mesh.h"
+#include "engine/vertex_fields.h"
+#include "stages/photo_views.h"
+
+namespace mvflow {
+
+struct PhotoConsistencyOptions {
+  int half_patch = 2;  //!< patch of (2·half_patch+1)² pixels; 2 = the thesis's 5×5 (range 1..7)
+  bool check() const { return half_patch >= 1 && half_patch <= 7; }
+};
+
+//! g at one point and the number of views that contributed.
+struct PhotoValue {
+  double g = 0.0;
+  int views = 0;
+  bool defined() const { return views >= 2; }
+};
+
+//! g(X) over the views \p view_ids of \p views.
+PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
+                             const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options = {});
+
+//! g at every vertex of \p vertices over its visible views (fields.visible_views, from the
+//! visibility stage). Writes photo_consistency and the kPhotoDefined bit of those vertices only.
+void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
+                               const PhotoConsistencyOptions& options, VertexFields& fields);
+
+}  // namespace mvflow

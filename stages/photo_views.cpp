@@ -1,0 +1,34 @@
+#include "stages/photo_views.h"
+
+#include "engine/error.h"
+
+namespace mvflow {
+
+std::vector<PhotoView> make_photo_views(const std::vector<Camera>& cameras, const std::vector<const Image*>& images) {
+  MVFLOW_CHECK(cameras.size() == images.size(), "one image per camera");
+  std::vector<PhotoView> views(cameras.size());
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const Camera& camera = cameras[i];
+    MVFLOW_CHECK(images[i] != nullptr, "image missing");
+    MVFLOW_CHECK(images[i]->width() == camera.width() && images[i]->height() == camera.height(),
+                 "image size differs from its camera's");
+    views[i] = {&camera, images[i], camera.projection_matrix(), camera.distortion().is_identity(), camera.width(),
+                camera.height()};
+  }
+  return views;
+}
+
+std::vector<PhotoView> make_photo_views(const Scene& scene) {
+  std::vector<PhotoView> views(scene.size());
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    const Camera& camera = scene.views[i].camera;
+    const Image& image = scene.image(i);
+    MVFLOW_CHECK(image.width() == camera.width() && image.height() == camera.height(),
+                 "image size differs from its camera's");
+    views[i] = {&camera, &image, camera.projection_matrix(), camera.distortion().is_identity(), camera.width(),
+                camera.height()};
+  }
+  return views;
+}
+
+}  // namespace mvflow

@@ -1,0 +1,98 @@
+#include "stages/speed.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "stages/one_ring.h"
+
+namespace mvflow {
+namespace {
+
+constexpr std::uint8_t speed_inputs = kPhotoDefined | kGradientDefined | kNormalDefined | kCurvatureDefined;
+
+}  // namespace
+
+bool SpeedOptions::check() const {
+  return std::isfinite(velocity);
+}
+
+void compute_speed(IndexRange vertices, const SpeedOptions& options, VertexFields& fields) {
+  MVFLOW_CHECK(options.check(), "compute_speed: invalid SpeedOptions");
+  detail::check_range(vertices, fields.size(), "compute_speed");
+  for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
+    fields.speed[id] = Eigen::Vector3d::Zero();
+    fields.defined[id] &= static_cast<std::uint8_t>(~kSpeedDefined);
+    if ((fields.defined[id] & speed_inputs) != speed_inputs) continue;
+    const Eigen::Vector3d& n = fields.normal[id];
+    const double g = fields.photo_consistency[id];
+    const double normal_speed =
+        g * (options.velocity + fields.mean_curvature[id]) + fields.photo_gradient[id].dot(n);
+    const Eigen::Vector3d f = -normal_speed * n;
+    if (!f.allFinite()) continue;
+    fields.speed[id] = f;
+    fields.defined[id] |= kSpeedDefined;
+  }
+}
+
+BlockPartial reduce_block(IndexRange vertices, const VertexFields& fields) {
+  detail::check_range(vertices, fields.size(), "reduce_block");
+  BlockPartial partial;
+  for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
+    if (fields.defined[id] & kSpeedDefined)
+      partial.max_speed = std::max(partial.max_speed, fields.speed[id].norm());
+    if (fields.defined[id] & kPhotoDefined) {
+      partial.sum_g += fields.photo_consistency[id];
+      ++partial.defined_g;
+    }
+  }
+  return partial;
+}
+
+BlockPartial combine(const std::vector<BlockPartial>& partials) {
+  BlockPartial total;
+  for (const BlockPartial& p : partials) {
+    total.max_speed = std::max(total.max_speed, p.max_speed);
+    total.sum_g += p.sum_g;
+    total.defined_g += p.defined_g;
+  }
+  return total;
+}
+
+double cfl_time_step(double shortest_edge, double max_speed, double cfl) {
+  MVFLOW_CHECK(shortest_edge > 0.0 && std::isfinite(shortest_edge),
+               "cfl_time_step: shortest edge must be > 0");
+  MVFLOW_CHECK(max_speed >= 0.0 && std::isfinite(max_speed),
+               "cfl_time_step: max speed must be finite and >= 0");
+  MVFLOW_CHECK(cfl > 0.0 && std::isfinite(cfl), "cfl_time_step: cfl must be > 0");
+  if (max_speed == 0.0) return 0.0;
+  return cfl * (0.5 * shortest_edge) / (std::sqrt(3.0) * max_speed);
+}
+
+void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt) {
+  MVFLOW_CHECK(dt >= 0.0 && std::isfinite(dt), "move_vertices: dt must be finite and >= 0");
+  detail::check_range(vertices, mesh.n_vertices(), "move_vertices");
+  MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "move_vertices: fields are not sized for the mesh");
+  for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
+    const auto v = detail::handle(id);
+    if (!(fields.defined[id] & kSpeedDefined) || mesh.is_boundary(v)) continue;
+    mesh.set_point(v, mesh.point(v) + to_openmesh(dt * fields.speed[id]));
+  }
+}
+
+double median_speed(const TriMesh& mesh, const VertexFields& fields) {
+  MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "median_speed: fields are not sized for the mesh");
+  std::vector<double> speeds;
+  speeds.reserve(fields.size());
+  for (std::uint32_t id = 0; id < fields.size(); ++id)
+    if ((fields.defined[id] & kSpeedDefined) && !mesh.is_boundary(detail::handle(id)))
+      speeds.push_back(fields.speed[id].norm());
+  if (speeds.empty()) return 0.0;
+  const std::size_t upper = speeds.size() / 2;
+  std::nth_element(speeds.begin(), speeds.begin() + upper, speeds.end());
+  if (speeds.size() % 2 == 1) return speeds[upper];
+  // Even count: mean of the two middle values; the lower one is the max of the lower half.
+  const double lower = *std::max_element(speeds.begin(), speeds.begin() + upper);
+  return 0.5 * (lower + speeds[upper]);
+}
+
+}  // namespace mvflow

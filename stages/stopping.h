@@ -1,0 +1,75 @@
+#pragma once
+// When the flow stops (thesis 5.3.3; SPEC §4).
+
+#include <cstddef>
+#include <vector>
+
+namespace mvflow {
+
+enum class StopReason {
+  Continue,       //!< keep iterating
+  Converged,      //!< Σg changed by less than ε % against each of the last `lookback` iterations
+  StepSmall,      //!< the median vertex move fell below τ·e_min
+  MaxIterations,  //!< the iteration budget is used up
+};
+
+//! "continue", "converged", "step-small" or "max-iterations" (for reports).
+const char* to_string(StopReason reason);
+
+struct StoppingOptions {
+  //! ε in percent: converged when |100 − 100·G_i/G_{i−l}| < ε for l = 1..lookback; > 0.
+  //! 0.3 (the thesis's experiments).
+  double epsilon_percent = 0.3;
+  //! No stop (Converged or StepSmall) before this many completed iterations; ≥ lookback + 1,
+  //! so that every G_{i−l} exists. 10 (thesis 5.3.3).
+  int min_iterations = 10;
+  //! Stop after this many completed iterations at the latest; ≥ min_iterations. 100 (thesis).
+  int max_iterations = 100;
+  //! Number of previous iterations Σg is compared with; ≥ 1. 5 (thesis 5.3.3).
+  int lookback = 5;
+  //! τ: StepSmall when median_P |Δt·F(P)| / e_min < τ; ≥ 0 (0 disables). 0.002 (SPEC §4,
+  //! replacing the thesis's absolute "step size below 1e−5").
+  double median_move_tolerance = 0.002;
+
+  bool check() const;
+};
+
+//! The stopping test of the flow, fed once per completed iteration.
+//!
+//! Iterations are counted from 1: the i-th call of add_iteration reports iteration i, and
+//! i is the number of completed iterations. With G_i the Σg passed at iteration i:
+//!  - Converged at i ≥ min_iterations when, for every l = 1..lookback,
+//!    |100 − 100·G_i/G_{i−l}| < ε (a G_{i−l} = 0 counts as a change of 0 if G_i = 0 too and as
+//!    an infinite change otherwise);
+//!  - StepSmall at i ≥ min_iterations when median_move_over_emin < τ. Like the ε rule it waits
+//!    for min_iterations: the first iterations run on a freshly remeshed surface whose median
+//!    move says little about convergence, and a few extra iterations cost little;
+//!  - MaxIterations at i ≥ max_iterations.
+//! When several fire at once the first in this list is reported. After a stop, further calls
+//! keep evaluating the same rules on the longer history.
+class StoppingCriterion {
+ public:
+  //! \throw Error if !options.check().
+  explicit StoppingCriterion(StoppingOptions options);
+
+  //! Records iteration i = iterations() + 1 and returns whether to stop after it.
+  //! \param sum_g               G_i = Σ g(P) over the vertices with defined g, ≥ 0.
+  //! \param median_move_over_emin median over the moving vertices of |Δt·F(P)| divided by the
+  //!                              shortest edge; pass 0 when nothing moved (NaN never fires).
+  StopReason add_iteration(double sum_g, double median_move_over_emin);
+
+  //! Completed iterations so far (the i of the last add_iteration).
+  std::size_t iterations() const { return history_.size(); }
+  //! |100 − 100·G_i/G_{i−l}| of the last iteration for l = 1..lookback (fewer if the history
+  //! is shorter), for reports.
+  std::vector<double> last_changes_percent() const;
+  const StoppingOptions& options() const { return options_; }
+
+ private:
+  double change_percent(std::size_t lag) const;
+
+  StoppingOptions options_;
+  std::vector<double> history_;  // G_1 .. G_i
+};
+
+}  // namespace mvflow

@@ -1,0 +1,40 @@
+#include "stages/visibility.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "engine/error.h"
+
+namespace mvflow {
+
+void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
+                        const SurfaceQuery& surface, double mean_edge, const VisibilityOptions& options,
+                        VertexFields& fields) {
+  MVFLOW_CHECK(options.check(), "visibility options out of range");
+  MVFLOW_CHECK(fields.view_capacity >= views.size(), "vertex fields sized for fewer views");
+  const double cos_max = std::cos(options.max_angle_degrees * std::numbers::pi / 180.0);
+  const double offset = options.ray_offset * mean_edge;
+  for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
+    std::uint16_t* visible = fields.visible_views.data() + v * fields.view_capacity;
+    std::uint16_t count = 0;
+    if (fields.defined[v] & kNormalDefined) {
+      const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+      const Eigen::Vector3d& N = fields.normal[v];
+      const Eigen::Vector3d origin = P + offset * N;
+      for (std::size_t i = 0; i < views.size(); ++i) {
+        const PhotoView& view = views[i];
+        const Projection p = view.project(P);
+        if (!(p.depth > 0) || !view.patch_inside(p.u, p.v, options.half_patch)) continue;
+        const Eigen::Vector3d to_camera = view.camera->centre() - P;
+        const double distance = to_camera.norm();
+        if (!(N.dot(to_camera) > cos_max * distance)) continue;
+        const Eigen::Vector3d from_origin = view.camera->centre() - origin;
+        if (surface.occluded(origin, from_origin, 0.0, 1.0)) continue;
+        visible[count++] = static_cast<std::uint16_t>(i);
+      }
+    }
+    fields.visible_count[v] = count;
+  }
+}
+
+}  // namespace mvflow

@@ -1,0 +1,114 @@
+// The stopping rule (SPEC §4): hand-made Σg sequences.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "engine/error.h"
+#include "stages/stopping.h"
+
+namespace mvflow {
+namespace {
+
+constexpr double large_move = 1.0;  // far above τ: only the Σg rule or the budget can fire
+
+// Feeds \p g and returns the iteration (1-based) at which the criterion stopped, 0 if never.
+std::pair<std::size_t, StopReason> run(const std::vector<double>& g, double move = large_move,
+                                       StoppingOptions options = {}) {
+  StoppingCriterion criterion(options);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const StopReason reason = criterion.add_iteration(g[i], move);
+    EXPECT_EQ(criterion.iterations(), i + 1);
+    if (reason != StopReason::Continue) return {i + 1, reason};
+  }
+  return {0, StopReason::Continue};
+}
+
+TEST(StoppingOptions, DefaultsFollowTheThesis) {
+  const StoppingOptions o;
+  EXPECT_TRUE(o.check());
+  EXPECT_EQ(o.epsilon_percent, 0.3);
+  EXPECT_EQ(o.min_iterations, 10);
+  EXPECT_EQ(o.max_iterations, 100);
+  EXPECT_EQ(o.lookback, 5);
+  EXPECT_EQ(o.median_move_tolerance, 0.002);
+  EXPECT_FALSE((StoppingOptions{.epsilon_percent = 0.0}).check());
+  EXPECT_FALSE((StoppingOptions{.min_iterations = 5}).check());  // needs lookback + 1
+  EXPECT_FALSE((StoppingOptions{.max_iterations = 9}).check());
+  EXPECT_THROW(StoppingCriterion(StoppingOptions{.lookback = 0}), Error);
+  EXPECT_STREQ(to_string(StopReason::Converged), "converged");
+  EXPECT_STREQ(to_string(StopReason::StepSmall), "step-small");
+  EXPECT_STREQ(to_string(StopReason::MaxIterations), "max-iterations");
+  EXPECT_STREQ(to_string(StopReason::Continue), "continue");
+}
+
+TEST(Stopping, NeverBeforeIterationTenEvenWhenConstant) {
+  EXPECT_EQ(run(std::vector<double>(30, 5.0)), std::make_pair(std::size_t{10}, StopReason::Converged));
+  // All-zero Σg (every view agrees) counts as no change.
+  EXPECT_EQ(run(std::vector<double>(30, 0.0)), std::make_pair(std::size_t{10}, StopReason::Converged));
+}
+
+TEST(Stopping, AtTheFirstIterationWhereAllFiveChangesAreBelowEpsilon) {
+  // Σg falls 1 % per iteration up to iteration 20, then stays: at 24 the change against G_19
+  // is still 1 %, at 25 all of G_20..G_24 equal G_25.
+  std::vector<double> g;
+  for (int i = 1; i <= 40; ++i) g.push_back(1000.0 * std::pow(0.99, std::min(i, 20)));
+  EXPECT_EQ(run(g), std::make_pair(std::size_t{25}, StopReason::Converged));
+  // 0.05 % per iteration: the lag-5 change is 0.25 % < 0.3 % from the start, so iteration 10.
+  g.clear();
+  for (int i = 1; i <= 40; ++i) g.push_back(1000.0 * std::pow(0.9995, i));
+  EXPECT_EQ(run(g), std::make_pair(std::size_t{10}, StopReason::Converged));
+  // 0.07 % per iteration: lag 5 is ≈ 0.349 % ≥ 0.3 %: never converges, the budget ends it.
+  g.clear();
+  for (int i = 1; i <= 120; ++i) g.push_back(1000.0 * std::pow(0.9993, i));
+  EXPECT_EQ(run(g), std::make_pair(std::size_t{100}, StopReason::MaxIterations));
+  // One drop of 0.5 % at iteration 8 holds convergence off until G_7 leaves the window: at 12
+  // the lag-5 change (against G_7) is 0.5 %, at 13 every G_{i−l} is G_8 = 99.5.
+  g.assign(40, 100.0);
+  for (std::size_t i = 7; i < g.size(); ++i) g[i] = 99.5;
+  EXPECT_EQ(run(g), std::make_pair(std::size_t{13}, StopReason::Converged));
+}
+
+TEST(Stopping, AtMaxIterationsAtTheLatest) {
+  std::vector<double> g;
+  for (int i = 1; i <= 150; ++i) g.push_back(i % 2 ? 100.0 : 110.0);
+  EXPECT_EQ(run(g), std::make_pair(std::size_t{100}, StopReason::MaxIterations));
+  StoppingOptions short_run;
+  short_run.max_iterations = 12;
+  EXPECT_EQ(run(g, large_move, short_run), std::make_pair(std::size_t{12}, StopReason::MaxIterations));
+  // A zero G_{i−l} with a positive G_i is an infinite change, not convergence.
+  for (auto& x : g) x = 0.0;
+  for (std::size_t i = 0; i < g.size(); i += 3) g[i] = 1.0;
+  EXPECT_EQ(run(g), std::make_pair(std::size_t{100}, StopReason::MaxIterations));
+}
+
+TEST(Stopping, WhenTheMedianMoveIsSmallFromMinIterationsOn) {
+  std::vector<double> g;
+  for (int i = 1; i <= 50; ++i) g.push_back(i % 2 ? 100.0 : 110.0);  // Σg never converges
+  EXPECT_EQ(run(g, 0.001), std::make_pair(std::size_t{10}, StopReason::StepSmall));
+  EXPECT_EQ(run(g, 0.0), std::make_pair(std::size_t{10}, StopReason::StepSmall));  // nothing moved
+  EXPECT_EQ(run(g, 0.0025).second, StopReason::Continue);  // above τ = 0.002: runs out of g
+  EXPECT_EQ(run(g, std::nan("")).second, StopReason::Continue);
+  // A small move at iteration 13 only.
+  StoppingCriterion criterion{StoppingOptions{}};
+  for (int i = 1; i <= 12; ++i) EXPECT_EQ(criterion.add_iteration(g[i - 1], 0.5), StopReason::Continue);
+  EXPECT_EQ(criterion.add_iteration(g[12], 0.0019), StopReason::StepSmall);
+  // Converged wins when both fire.
+  EXPECT_EQ(run(std::vector<double>(30, 5.0), 0.0), std::make_pair(std::size_t{10}, StopReason::Converged));
+}
+
+TEST(Stopping, ReportsTheLastChanges) {
+  StoppingCriterion criterion{StoppingOptions{}};
+  criterion.add_iteration(100.0, 1.0);
+  EXPECT_TRUE(criterion.last_changes_percent().empty());
+  criterion.add_iteration(99.0, 1.0);
+  criterion.add_iteration(99.0, 1.0);
+  const auto changes = criterion.last_changes_percent();
+  ASSERT_EQ(changes.size(), 2u);
+  EXPECT_EQ(changes[0], 0.0);
+  EXPECT_NEAR(changes[1], 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace mvflow
