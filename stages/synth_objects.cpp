@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <numeric>
+#include <vector>
 
 #include "engine/bounding_box.h"
 #include "engine/error.h"
@@ -60,6 +63,45 @@ Normalization normalize_to_unit_box(IndexedMesh& mesh) {
   Normalization n{box.centre(), 2.0 / longest};
   for (auto& p : mesh.positions) p = n.scale * (p - n.centre);
   return n;
+}
+
+std::size_t split_pinched_vertices(IndexedMesh& mesh) {
+  std::vector<std::vector<std::uint32_t>> incident(mesh.positions.size());
+  for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f)
+    for (auto v : mesh.triangles[f]) incident[v].push_back(f);
+  const std::size_t original = mesh.positions.size();
+  for (std::uint32_t v = 0; v < original; ++v) {
+    const auto& faces = incident[v];
+    if (faces.size() < 2) continue;
+    // Faces around v are in one fan when linked through edges (v, w): union-find over them.
+    std::vector<std::size_t> parent(faces.size());
+    std::iota(parent.begin(), parent.end(), std::size_t{0});
+    const auto root = [&](std::size_t i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    std::map<std::uint32_t, std::size_t> first_face_with;
+    for (std::size_t i = 0; i < faces.size(); ++i)
+      for (auto w : mesh.triangles[faces[i]]) {
+        if (w == v) continue;
+        const auto [it, inserted] = first_face_with.emplace(w, i);
+        if (!inserted) parent[root(i)] = root(it->second);
+      }
+    std::map<std::size_t, std::uint32_t> copy_of_fan;  // fan root → vertex id
+    copy_of_fan[root(0)] = v;
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      auto [it, inserted] = copy_of_fan.emplace(root(i), 0);
+      if (inserted) {
+        it->second = static_cast<std::uint32_t>(mesh.positions.size());
+        mesh.positions.push_back(mesh.positions[v]);
+        if (mesh.has_colors()) mesh.colors.push_back(mesh.colors[v]);
+        if (mesh.has_quality()) mesh.quality.push_back(mesh.quality[v]);
+      }
+      for (auto& corner : mesh.triangles[faces[i]])
+        if (corner == v) corner = it->second;
+    }
+  }
+  return mesh.positions.size() - original;
 }
 
 double radius_about_origin(const IndexedMesh& mesh) {

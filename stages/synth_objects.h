@@ -37,6 +37,11 @@ struct Normalization {
 //! \throw InputError when the mesh is empty or flat in every direction.
 Normalization normalize_to_unit_box(IndexedMesh& mesh);
 
+//! Gives every extra fan of faces around a vertex its own copy of the vertex (a "pinched"
+//! vertex where two cones of a closed surface touch, as in cow.obj), so the mesh becomes
+//! manifold without moving any point. \return the number of vertices added.
+std::size_t split_pinched_vertices(IndexedMesh& mesh);
+
 //! The largest distance of a vertex from the origin (the object radius used to place cameras).
 double radius_about_origin(const IndexedMesh& mesh);
 

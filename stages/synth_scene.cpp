@@ -84,15 +84,16 @@ SynthScene make_synth_scene(const IndexedMesh& truth, std::shared_ptr<const Imag
   scene.bounding_box.min = box.min.array() - margin;
   scene.bounding_box.max = box.max.array() + margin;
 
+  // The initial mesh first: it rejects an open or non-manifold truth before seconds of rendering.
+  InitialMeshOptions init = options.init;
+  init.seed = mix_seed(options.seed, kInitNoise);
+  scene.initial = make_initial_mesh(truth, init);
+
   scene.views = make_rig(options.rig, scene.centre, scene.radius);
   const SynthRenderer renderer =
       make_synth_renderer(truth, std::move(uv_texture), options, scene.centre, scene.radius, &scene.uv_albedo);
   scene.images.reserve(scene.views.size());
   for (std::size_t i = 0; i < scene.views.size(); ++i) scene.images.push_back(renderer.render(scene.views[i].camera, i));
-
-  InitialMeshOptions init = options.init;
-  init.seed = mix_seed(options.seed, kInitNoise);
-  scene.initial = make_initial_mesh(truth, init);
   return scene;
 }
 

@@ -219,6 +219,24 @@ TEST(Synth, NormalizationFitsAUnitBoxAndIsRecorded) {
   EXPECT_NEAR(radius_about_origin(mesh), 1.0, 1e-12);
 }
 
+TEST(Synth, PinchedVertexIsSplitSoTheSurfaceBecomesManifold) {
+  // Two tetrahedra touching at vertex 0 (like the cow's pinched vertex).
+  IndexedMesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 1}, {-1, 0, 0}, {0, -1, 0}, {-1, -1, -1}};
+  mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}, {0, 5, 4}, {0, 4, 6}, {0, 6, 5}, {4, 5, 6}};
+  MeshBuildReport before;
+  build_mesh(mesh, "pinched", &before);
+  EXPECT_GT(before.rejected_faces, 0u);
+  EXPECT_EQ(split_pinched_vertices(mesh), 1u);
+  MeshBuildReport after;
+  const MeshStats stats = compute_mesh_stats(build_mesh(mesh, "split", &after));
+  EXPECT_EQ(after.rejected_faces, 0u);
+  EXPECT_TRUE(stats.is_closed());
+  EXPECT_EQ(stats.components, 2u);
+  EXPECT_EQ(mesh.positions[7], mesh.positions[0]);  // nothing moved
+  EXPECT_EQ(split_pinched_vertices(mesh), 0u);
+}
+
 // Distances from the initial mesh's vertices to the truth.
 struct InitDistances {
   double mean = 0.0, coefficient_of_variation = 0.0, max = 0.0;
@@ -373,7 +391,7 @@ TEST(SynthCommand, UvTexturedSpotWhenTheSharedDataIsThere) {
 TEST(SynthCommand, BadOptionsExitTwoAndMissingFilesExitOne) {
   test::ScratchFolder folder;
   const std::string out = " -o " + (folder / "x").string();
-  for (const std::string bad : {"--views 0", "--init bogus:1", "--elevation 10", "--preset nope", "--noise -1",
+  for (const std::string bad : {"--views 0", "--init bogus:1", "--elevation 10", "--elevation 40,10", "--light 0,0,0", "--preset nope", "--noise -1",
                                 "--albedo paint"}) {
     const CommandResult r = run("synth " + bad + out);
     EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;

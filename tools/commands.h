@@ -25,4 +25,7 @@ void add_synth_command(CLI::App& app, Runner& runner);
 //! `mvflow eval MESH TRUTH [--json FILE] [--samples N] [--threshold F]`
 void add_eval_command(CLI::App& app, Runner& runner);
 
+//! `mvflow slice SCENE [--mesh FILE] -o OUT.png [--axis x|y|z] [--position F]`
+void add_slice_command(CLI::App& app, Runner& runner);
+
 }  // namespace mvflow::cli

@@ -2,9 +2,9 @@
 // ground truth (cameras, PNG photographs, truth.ply, init.ply, bbox.txt, synth.json).
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fmt/format.h>
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -103,7 +103,6 @@ std::map<std::string, Settings> presets() {
 fs::path resolve_shared(const std::string& name) {
   if (!name.starts_with("shared:")) return name;
   const fs::path relative = fs::path("shared") / "data" / name.substr(7);
-  std::vector<fs::path> roots;
   if (const char* data = std::getenv("MVFLOW_DATA")) {
     const fs::path candidate = fs::path(data) / name.substr(7);
     if (fs::exists(candidate)) return candidate;
@@ -136,13 +135,27 @@ std::string parse_numbers(const std::string& text, std::size_t count, std::vecto
   return {};
 }
 
-CLI::Validator numbers(std::size_t count) {
+// \p extra checks the parsed values and returns an error message, or "" when they are fine.
+CLI::Validator numbers(std::size_t count, const std::string& name,
+                       std::function<std::string(const std::vector<double>&)> extra) {
   return CLI::Validator(
-      [count](std::string& text) {
+      [count, extra](std::string& text) {
         std::vector<double> values;
-        return parse_numbers(text, count, values);
+        const std::string error = parse_numbers(text, count, values);
+        return error.empty() ? extra(values) : error;
       },
-      std::to_string(count) + " NUMBERS");
+      name);
+}
+
+std::string check_elevation(const std::vector<double>& v) {
+  if (!(v[0] >= -85 && v[0] <= v[1] && v[1] <= 85)) return "expected MIN,MAX with -85 <= MIN <= MAX <= 85 degrees";
+  return {};
+}
+
+std::string check_light(const std::vector<double>& v) {
+  if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2])) || (v[0] == 0 && v[1] == 0 && v[2] == 0))
+    return "expected a non-zero direction X,Y,Z";
+  return {};
 }
 
 struct InitSpec {
@@ -253,6 +266,8 @@ LoadedObject load_object(const Settings& s, spdlog::logger& log) {
   object.mesh = io::read_mesh(file);
   object.mesh_file = file.string();
   object.normalization = normalize_to_unit_box(object.mesh);
+  if (const std::size_t added = split_pinched_vertices(object.mesh))
+    log.warn("{}: {} pinched (non-manifold) vertex(es) split so the surface is manifold", file.string(), added);
   fs::path texture;
   if (!s.texture.empty()) texture = resolve_shared(s.texture);
   else if (!object.mesh.texture_file.empty()) texture = file.parent_path() / object.mesh.texture_file;
@@ -339,7 +354,13 @@ int run_synth(SynthArguments& args, spdlog::logger& log) {
 
   const LoadedObject object = load_object(s, log);
   const auto start = std::chrono::steady_clock::now();
-  SynthScene scene = make_synth_scene(object.mesh, object.texture, options);
+  SynthScene scene;
+  try {
+    scene = make_synth_scene(object.mesh, object.texture, options);
+  } catch (const InputError& e) {
+    if (object.mesh_file.empty()) throw;
+    throw InputError(object.mesh_file, 0, e.what());  // e.g. an open mesh: name the file
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The texture coordinates belong to the UV texture, which the scene folder does not carry.
   scene.truth.texcoords.clear();
@@ -378,7 +399,7 @@ void add_synth_command(CLI::App& app, Runner& runner) {
   bind_option(c, a, "--seed", &Settings::seed, "Seed of the textures, the pixel noise and init noise");
   bind_option(c, a, "--ambient", &Settings::ambient, "Ambient light (fraction of the albedo)")->check(CLI::Range(0.0, 2.0));
   bind_option(c, a, "--diffuse", &Settings::diffuse, "Directional light's Lambertian weight")->check(CLI::Range(0.0, 2.0));
-  bind_option(c, a, "--light", &Settings::light, "Direction towards the light, X,Y,Z")->check(numbers(3));
+  bind_option(c, a, "--light", &Settings::light, "Direction towards the light, X,Y,Z")->check(numbers(3, "X,Y,Z", check_light));
   {
     CLI::Option* flat = c->add_flag("--flat", args->settings.flat, "Shade with face normals (default: smooth)");
     args->fill_from_preset.push_back([flat](const Settings& p, Settings& s) {
@@ -399,7 +420,7 @@ void add_synth_command(CLI::App& app, Runner& runner) {
   bind_option(c, a, "--views", &Settings::views, "Number of cameras")->check(CLI::Range(1, 1000));
   bind_option(c, a, "--distance", &Settings::distance, "Camera distance to the object centre, x object radius")
       ->check(CLI::Range(1.01, 1e5));
-  bind_option(c, a, "--elevation", &Settings::elevation, "MIN,MAX degrees above the horizon (-85..85)")->check(numbers(2));
+  bind_option(c, a, "--elevation", &Settings::elevation, "MIN,MAX degrees above the horizon (-85..85)")->check(numbers(2, "MIN,MAX", check_elevation));
   bind_option(c, a, "--width", &Settings::width, "Image width in pixels")->check(CLI::Range(8, 8192));
   bind_option(c, a, "--height", &Settings::height, "Image height in pixels")->check(CLI::Range(8, 8192));
   bind_option(c, a, "--fov", &Settings::fov, "Horizontal field of view in degrees (unless --focal)")->check(CLI::Range(1.0, 170.0));
