@@ -28,4 +28,7 @@ void add_eval_command(CLI::App& app, Runner& runner);
 //! `mvflow slice SCENE [--mesh FILE] -o OUT.png [--axis x|y|z] [--position F]`
 void add_slice_command(CLI::App& app, Runner& runner);
 
+//! `mvflow refine SCENE --mesh FILE -o OUT [--threads N] [--report FILE.json] ...`
+void add_refine_command(CLI::App& app, Runner& runner);
+
 }  // namespace mvflow::cli

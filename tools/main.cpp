@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   Runner runner;
   add_info_command(app, runner);
   add_convert_command(app, runner);
+  add_refine_command(app, runner);
   add_eval_command(app, runner);
   add_slice_command(app, runner);
   add_synth_command(app, runner);

@@ -1,0 +1,134 @@
+#include "engine/iteration.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "engine/error.h"
+#include "stages/commit.h"
+#include "stages/curvature.h"
+#include "stages/normals.h"
+#include "stages/regularization.h"
+#include "stages/smoothing.h"
+#include "stages/visibility.h"
+
+namespace mvflow {
+
+namespace {
+
+// Adds the wall time of its scope to one stage's slot.
+class StageTimer {
+ public:
+  explicit StageTimer(double& slot) : slot_(slot), start_(std::chrono::steady_clock::now()) {}
+  ~StageTimer() { slot_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+ private:
+  double& slot_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
+
+IterationData::IterationData(TriMesh& mesh_, const std::vector<PhotoView>& views_, const RefineOptions& options_,
+                             const std::atomic<bool>* cancel_)
+    : mesh(mesh_), views(views_), options(options_), cancel(cancel_), photo(options_.photo) {}
+
+void IterationData::reset_topology() {
+  surface = std::make_unique<SurfaceQuery>(mesh);
+  fields.resize(mesh.n_vertices(), views.size());
+  blocks = split_into_blocks(mesh.n_vertices(), options.block_size);
+  partials.assign(blocks.size(), BlockPartial{});
+  new_positions.assign(mesh.n_vertices(), Eigen::Vector3d::Zero());
+  block_seconds.assign(blocks.size(), {});
+  refit_needed = false;
+}
+
+void IterationData::refit() {
+  if (cancelled()) return;
+  StageTimer timer(serial_seconds[static_cast<int>(Stage::Refit)]);
+  if (refit_needed) surface->update_positions(mesh);
+  refit_needed = true;  // every later iteration moves the vertices first
+}
+
+void IterationData::geometry(std::size_t block) {
+  if (cancelled()) return;
+  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Geometry)]);
+  compute_normals(mesh, blocks[block], fields);
+  compute_mean_curvature(mesh, blocks[block], fields, options.curvature);
+}
+
+void IterationData::visibility(std::size_t block) {
+  if (cancelled()) return;
+  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Visibility)]);
+  compute_visibility(mesh, blocks[block], views, *surface, mean_edge, options.visibility, fields);
+}
+
+void IterationData::photo_speed(std::size_t block) {
+  if (cancelled()) return;
+  StageTimer timer(block_seconds[block][static_cast<int>(Stage::PhotoGradient)]);
+  photo.run(mesh, blocks[block], views, sample_spacing, fields);
+  compute_speed(blocks[block], options.speed, fields);
+  partials[block] = reduce_block(blocks[block], fields);
+}
+
+void IterationData::cfl() {
+  if (cancelled()) return;
+  StageTimer timer(serial_seconds[static_cast<int>(Stage::Cfl)]);
+  total = combine(partials);
+  // Σg again over all vertices in id order: the per-block partial sums would associate the
+  // additions differently for another block size, and Σg steers the stopping rule, so it must
+  // not depend on the blocking (a max and a count do not).
+  double sum_g = 0.0;
+  for (std::size_t v = 0; v < fields.size(); ++v)
+    if (fields.defined[v] & kPhotoDefined) sum_g += fields.photo_consistency[v];
+  total.sum_g = sum_g;
+  time_step = cfl_time_step(shortest_edge, total.max_speed, options.cfl);
+  moving = 0;
+  for (std::uint8_t bits : fields.defined) moving += (bits & kSpeedDefined) != 0;
+  median_move = shortest_edge > 0 ? time_step * median_speed(mesh, fields) / shortest_edge : 0.0;
+}
+
+void IterationData::move(std::size_t block) {
+  if (cancelled()) return;
+  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Move)]);
+  move_vertices(mesh, blocks[block], fields, time_step);
+}
+
+void IterationData::smooth(std::size_t block) {
+  if (cancelled()) return;
+  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Smoothing)]);
+  smooth_curvature_normal(mesh, blocks[block], options.smoothing, new_positions);
+}
+
+void IterationData::regularize(std::size_t block) {
+  if (cancelled()) return;
+  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Regularization)]);
+  compute_normals(mesh, blocks[block], fields);  // at the smoothed positions
+  regularize_tangential(mesh, blocks[block], fields, options.regularization, new_positions);
+}
+
+void IterationData::commit(std::size_t block) {
+  if (cancelled()) return;
+  commit_positions(mesh, blocks[block], new_positions);
+}
+
+void run_iteration_sequential(IterationData& data) {
+  const std::size_t n = data.blocks.size();
+  data.refit();
+  for (std::size_t b = 0; b < n; ++b) data.geometry(b);
+  for (std::size_t b = 0; b < n; ++b) data.visibility(b);
+  for (std::size_t b = 0; b < n; ++b) data.photo_speed(b);
+  data.cfl();
+  for (std::size_t b = 0; b < n; ++b) data.move(b);
+  for (int step = 0; step < data.options.smoothing.steps; ++step) {
+    for (std::size_t b = 0; b < n; ++b) data.smooth(b);
+    for (std::size_t b = 0; b < n; ++b) data.commit(b);
+  }
+  for (int step = 0; step < data.options.regularization.steps; ++step) {
+    for (std::size_t b = 0; b < n; ++b) data.regularize(b);
+    for (std::size_t b = 0; b < n; ++b) data.commit(b);
+  }
+}
+
+}  // namespace mvflow

@@ -1,0 +1,77 @@
+#pragma once
+// One deformation iteration (SPEC §3–§6) cut into per-block kernels. The flow graph
+// (engine/iteration_graph.h) and the sequential path call exactly these functions, so both give
+// the same bits: every kernel writes only its own block's entries, and sums over blocks are
+// combined in block order.
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/mesh.h"
+#include "engine/refine_options.h"
+#include "engine/refine_report.h"
+#include "engine/surface_query.h"
+#include "engine/vertex_fields.h"
+#include "stages/photo_gradient.h"
+#include "stages/photo_views.h"
+#include "stages/speed.h"
+
+namespace mvflow {
+
+//! What the nodes of one iteration share. The mesh's positions change only in the move and
+//! commit kernels, and the Embree scene only in refit(), each ordered by the graph's edges.
+struct IterationData {
+  IterationData(TriMesh& mesh, const std::vector<PhotoView>& views, const RefineOptions& options,
+                const std::atomic<bool>* cancel);
+
+  TriMesh& mesh;
+  const std::vector<PhotoView>& views;
+  const RefineOptions& options;
+  const std::atomic<bool>* cancel;
+  PhotoGradientStage photo;
+
+  std::unique_ptr<SurfaceQuery> surface;  //!< rebuilt when the topology changes, refitted otherwise
+  VertexFields fields;
+  std::vector<IndexRange> blocks;
+  std::vector<BlockPartial> partials;            //!< one per block
+  std::vector<Eigen::Vector3d> new_positions;    //!< Jacobi buffer of smoothing / regularization
+  std::vector<std::array<double, kStageCount>> block_seconds;  //!< per block, per stage
+
+  // Set before the iteration runs.
+  double shortest_edge = 0.0;
+  double mean_edge = 0.0;
+  double sample_spacing = 0.0;
+  bool refit_needed = false;
+  // Set by the CFL kernel.
+  BlockPartial total;
+  double time_step = 0.0;
+  double median_move = 0.0;  //!< in units of e_min
+  std::size_t moving = 0;
+  double serial_seconds[kStageCount] = {};
+
+  //! Sizes everything for the mesh's current topology (new blocks, fields, Embree scene).
+  void reset_topology();
+  bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
+
+  // The kernels. `block` indexes `blocks`.
+  void refit();                        //!< serial: Embree refit to the current positions
+  void geometry(std::size_t block);    //!< N and H
+  void visibility(std::size_t block);  //!< visible views
+  void photo_speed(std::size_t block); //!< g, ∇g (3k+1 samples), F, and the block's partial
+  void cfl();                          //!< serial: combine partials in block order, Δt, median move
+  void move(std::size_t block);        //!< P ← P + Δt·F
+  void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
+  void regularize(std::size_t block);  //!< normals at the current positions, then regularization
+  void commit(std::size_t block);      //!< new positions into the mesh
+};
+
+//! Runs one iteration's kernels in a plain loop on the calling thread, in the order the graph's
+//! edges impose: the reference path for determinism tests and benchmarks.
+void run_iteration_sequential(IterationData& data);
+
+}  // namespace mvflow

@@ -1,0 +1,39 @@
+#include "engine/refine_options.h"
+
+#include "engine/error.h"
+
+namespace mvflow {
+
+void RefineOptions::check() const {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw InputError(std::string("option out of range: ") + what);
+  };
+  require(visibility.check(), "visibility (max angle in (0, 90], patch, ray offset)");
+  require(photo.check(), "photo consistency / Savitzky-Golay (k even >= 2, order, patch 1..7)");
+  require(speed.check(), "velocity");
+  require(cfl > 0 && cfl <= 10, "cfl (0, 10]");
+  require(smoothing.check(), "smoothing (lambda*dt in (0,1), steps >= 0)");
+  require(regularization.check(), "regularization (strength in (0,1], steps >= 0)");
+  require(stopping.check(), "stopping (epsilon, iterations, lookback, tolerance)");
+  require(block_size >= 1, "block size >= 1");
+  require(photo.photo.half_patch == visibility.half_patch, "the visibility patch must equal the photo patch");
+  for (int view : excluded_views) require(view >= 0, "excluded views are 0-based indices");
+}
+
+RefineOptions default_preset() { return RefineOptions{}; }
+
+RefineOptions thesis_preset() {
+  RefineOptions options;
+  options.visibility.max_angle_degrees = 90.0;
+  options.curvature.area = CurvatureArea::Barycentric;
+  options.stopping.epsilon_percent = 0.3;
+  return options;
+}
+
+RefineOptions preset(const std::string& name) {
+  if (name == "default") return default_preset();
+  if (name == "thesis") return thesis_preset();
+  throw InputError("unknown preset '" + name + "' (expected default or thesis)");
+}
+
+}  // namespace mvflow

@@ -1,0 +1,50 @@
+#pragma once
+// Every parameter of a refinement, one nested Options struct per stage (their defaults and
+// ranges are documented where each stage is declared), plus presets as functions.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "stages/curvature.h"
+#include "stages/photo_gradient.h"
+#include "stages/regularization.h"
+#include "stages/smoothing.h"
+#include "stages/speed.h"
+#include "stages/stopping.h"
+#include "stages/visibility.h"
+
+namespace mvflow {
+
+//! How an iteration's stages are scheduled. Both give bit-identical results.
+enum class EngineKind {
+  Graph,      //!< one oneTBB flow graph per iteration, nodes per vertex block (SPEC §6)
+  Sequential  //!< the same per-block stage functions in a plain loop on the calling thread
+};
+
+struct RefineOptions {
+  CurvatureOptions curvature;
+  VisibilityOptions visibility;
+  PhotoGradientOptions photo;          //!< Savitzky–Golay window and the photo-consistency patch
+  SpeedOptions speed;                  //!< balloon velocity v
+  double cfl = 1.0;                    //!< Δt = cfl·(e_min/2)/(√3·max|F|) (SPEC §4; thesis 1)
+  SmoothingOptions smoothing;
+  RegularizationOptions regularization;
+  StoppingOptions stopping;
+  std::size_t block_size = 1024;       //!< vertices per block (graph nodes work on one block)
+  EngineKind engine = EngineKind::Graph;
+  std::vector<int> excluded_views;     //!< 0-based view indices the refinement must not use
+
+  //! \throw InputError naming the first option out of range.
+  void check() const;
+};
+
+//! SPEC's defaults (this struct's initializers).
+RefineOptions default_preset();
+//! Exactly the thesis's parameters (appendix B.7, SPEC §9): grazing views up to 90°, the
+//! barycentric curvature area, ε = 0.3 %.
+RefineOptions thesis_preset();
+//! "default" or "thesis". \throw InputError otherwise.
+RefineOptions preset(const std::string& name);
+
+}  // namespace mvflow

@@ -1,0 +1,67 @@
+#pragma once
+// What a refinement reports: one record per iteration (the thesis's table 5.1 columns and more)
+// and a summary. Plain data, so that io/ can write it and hosts can read it without linking the
+// engine.
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace mvflow {
+
+//! The timed stages of an iteration (SPEC §7). For the flow graph each entry is the summed
+//! time of that stage's nodes over all blocks (CPU seconds); for the sequential path it is wall time.
+enum class Stage : int { Refinement, Refit, Geometry, Visibility, PhotoGradient, Cfl, Move, Smoothing, Regularization };
+inline constexpr std::size_t kStageCount = 9;
+inline constexpr std::array<const char*, kStageCount> kStageNames{
+    "refinement", "refit", "geometry", "visibility", "photo_gradient", "cfl", "move", "smoothing", "regularization"};
+
+struct IterationReport {
+  int iteration = 0;                  //!< 1-based
+  std::size_t vertices = 0;
+  std::size_t faces = 0;
+  std::size_t refined_faces = 0;      //!< faces split by adaptive refinement before this iteration
+  double sum_g = 0.0;                 //!< Σ g over vertices with defined g (the stopping criterion's G_i)
+  std::size_t defined_g = 0;          //!< vertices with defined g
+  std::size_t moving = 0;             //!< vertices with a defined speed
+  double shortest_edge = 0.0;         //!< e_min of the mesh the iteration started from
+  double max_speed = 0.0;             //!< max |F|
+  double time_step = 0.0;             //!< Δt (CFL)
+  double median_move = 0.0;           //!< median |Δt·F| over moving vertices, in units of e_min
+  std::string stop;                   //!< "continue", or why the refinement stops after it
+  double seconds = 0.0;               //!< wall time of the whole iteration
+  std::array<double, kStageCount> stage_seconds{};
+
+  double sum_g_per_vertex() const { return defined_g ? sum_g / static_cast<double>(defined_g) : 0.0; }
+};
+
+enum class RefineStatus { Converged, StepSmall, MaxIterations, Cancelled, Failed };
+const char* to_string(RefineStatus status);
+
+struct RefineSummary {
+  RefineStatus status = RefineStatus::Failed;
+  std::string message;                 //!< the error for Failed
+  std::size_t initial_vertices = 0;
+  std::size_t initial_faces = 0;
+  std::size_t final_vertices = 0;
+  std::size_t final_faces = 0;
+  double initial_sum_g_per_vertex = 0.0;  //!< after the global remeshing, before the flow
+  double final_sum_g_per_vertex = 0.0;    //!< at the final positions
+  std::size_t self_intersections = 0;     //!< pairs of non-adjacent faces that intersect (final mesh)
+  double seconds = 0.0;
+  std::vector<IterationReport> iterations;
+};
+
+inline const char* to_string(RefineStatus status) {
+  switch (status) {
+    case RefineStatus::Converged: return "converged";
+    case RefineStatus::StepSmall: return "step-small";
+    case RefineStatus::MaxIterations: return "max-iterations";
+    case RefineStatus::Cancelled: return "cancelled";
+    case RefineStatus::Failed: return "failed";
+  }
+  return "?";
+}
+
+}  // namespace mvflow

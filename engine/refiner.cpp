@@ -1,0 +1,280 @@
+#include "engine/refiner.h"
+
+#include <oneapi/tbb/info.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <span>
+
+#include "engine/error.h"
+#include "engine/iteration.h"
+#include "engine/iteration_graph.h"
+#include "stages/normals.h"
+#include "stages/photo_consistency.h"
+#include "stages/regularization.h"
+#include "stages/self_intersections.h"
+#include "stages/smoothing.h"
+#include "stages/visibility.h"
+
+namespace mvflow {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct EdgeStats {
+  double shortest = 0.0;
+  double mean = 0.0;
+};
+
+EdgeStats edge_stats(const TriMesh& mesh) {
+  EdgeStats stats{std::numeric_limits<double>::infinity(), 0.0};
+  for (auto e : mesh.edges()) {
+    const double length = mesh.calc_edge_length(e);
+    stats.shortest = std::min(stats.shortest, length);
+    stats.mean += length;
+  }
+  stats.mean /= static_cast<double>(std::max<std::size_t>(1, mesh.n_edges()));
+  return stats;
+}
+
+// The views the refinement may use, in scene order without the excluded ones.
+std::vector<PhotoView> usable_views(const Scene& scene, const std::vector<int>& excluded) {
+  std::vector<PhotoView> all = make_photo_views(scene);
+  std::vector<PhotoView> kept;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) != excluded.end()) continue;
+    kept.push_back(all[i]);
+  }
+  for (int view : excluded)
+    if (view >= static_cast<int>(all.size()))
+      throw InputError("excluded view " + std::to_string(view) + " does not exist (the scene has " +
+                       std::to_string(all.size()) + " views)");
+  if (kept.size() < 2) throw InputError("fewer than 2 views are left to refine with");
+  return kept;
+}
+
+// g at every vertex of the current mesh (normals, visibility, g; no gradient), and the mean
+// colour of the visible views: what the output mesh carries and the summary reports.
+struct SurfaceState {
+  std::vector<float> g;
+  std::vector<Eigen::Vector3f> colours;
+  double sum_g_per_vertex = 0.0;
+};
+
+SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>& views, const RefineOptions& options) {
+  VertexFields fields;
+  fields.resize(mesh.n_vertices(), views.size());
+  const IndexRange all{0, static_cast<std::uint32_t>(mesh.n_vertices())};
+  compute_normals(mesh, all, fields);
+  const SurfaceQuery surface(mesh);
+  compute_visibility(mesh, all, views, surface, edge_stats(mesh).mean, options.visibility, fields);
+  compute_photo_consistency(mesh, all, views, options.photo.photo, fields);
+  SurfaceState state;
+  state.g.resize(mesh.n_vertices(), 0.0f);
+  state.colours.resize(mesh.n_vertices(), Eigen::Vector3f::Zero());
+  double sum = 0.0;
+  std::size_t defined = 0;
+  for (std::uint32_t v = 0; v < mesh.n_vertices(); ++v) {
+    if (fields.defined[v] & kPhotoDefined) {
+      state.g[v] = static_cast<float>(fields.photo_consistency[v]);
+      sum += fields.photo_consistency[v];
+      ++defined;
+    }
+    const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+    Eigen::Vector3d colour = Eigen::Vector3d::Zero();
+    int seen = 0;
+    for (std::uint16_t k = 0; k < fields.visible_count[v]; ++k) {
+      const PhotoView& view = views[fields.visible_views[v * fields.view_capacity + k]];
+      const Projection p = view.project(P);
+      colour += view.image->sample_bilinear(p.u, p.v).cast<double>();
+      ++seen;
+    }
+    if (seen > 0) state.colours[v] = (colour / seen).cast<float>();
+  }
+  state.sum_g_per_vertex = defined ? sum / static_cast<double>(defined) : 0.0;
+  return state;
+}
+
+RefineStatus status_of(StopReason reason) {
+  switch (reason) {
+    case StopReason::Converged: return RefineStatus::Converged;
+    case StopReason::StepSmall: return RefineStatus::StepSmall;
+    default: return RefineStatus::MaxIterations;
+  }
+}
+
+class Refinement {
+ public:
+  Refinement(const Scene& scene, const Mesh& initial, const RefineOptions& options, const RefineControl& control)
+      : options_(options), control_(control), views_(usable_views(scene, options.excluded_views)),
+        mesh_(initial.topology), data_(mesh_, views_, options_, control.cancel) {}
+
+  RefineResult run() {
+    const auto start = Clock::now();
+    RefineResult result;
+    RefineSummary& summary = result.summary;
+    summary.initial_vertices = mesh_.n_vertices();
+    summary.initial_faces = mesh_.n_faces();
+    progress(0, "preparing");
+    prepare();
+    summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, views_, options_).sum_g_per_vertex;
+
+    StoppingCriterion stopping(options_.stopping);
+    std::unique_ptr<IterationGraph> graph;
+    RefineStatus status = RefineStatus::MaxIterations;
+    for (int iteration = 1;; ++iteration) {
+      if (cancelled()) {
+        status = RefineStatus::Cancelled;
+        break;
+      }
+      const auto iteration_start = Clock::now();
+      IterationReport report;
+      report.iteration = iteration;
+      double refinement_seconds = 0.0;
+      if (adapt(iteration, report, refinement_seconds) || !data_.surface) {
+        data_.reset_topology();
+        graph.reset();
+      }
+      const EdgeStats edges = edge_stats(mesh_);
+      data_.shortest_edge = edges.shortest;
+      data_.mean_edge = edges.mean;
+      data_.sample_spacing = data_.photo.sample_spacing(edges.shortest);
+      std::fill(std::begin(data_.serial_seconds), std::end(data_.serial_seconds), 0.0);
+      for (auto& slots : data_.block_seconds) slots.fill(0.0);
+
+      if (options_.engine == EngineKind::Graph) {
+        if (!graph) graph = std::make_unique<IterationGraph>(data_);  // inside the arena: attaches to it
+        graph->run();
+      } else {
+        run_iteration_sequential(data_);
+      }
+      if (cancelled()) {
+        status = RefineStatus::Cancelled;
+        break;
+      }
+      fill_report(report, edges, refinement_seconds, iteration_start);
+      const StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move);
+      report.stop = to_string(reason);
+      summary.iterations.push_back(report);
+      announce(report);
+      if (reason != StopReason::Continue) {
+        status = status_of(reason);
+        break;
+      }
+    }
+
+    progress(static_cast<int>(summary.iterations.size()), "finishing");
+    const SurfaceState final_state = evaluate_surface(mesh_, views_, options_);
+    summary.status = status;
+    summary.final_vertices = mesh_.n_vertices();
+    summary.final_faces = mesh_.n_faces();
+    summary.final_sum_g_per_vertex = final_state.sum_g_per_vertex;
+    summary.self_intersections = count_self_intersections(mesh_);
+    result.mesh.topology = mesh_;
+    result.mesh.quality = final_state.g;
+    result.mesh.colors = final_state.colours;
+    summary.seconds = seconds_since(start);
+    return result;
+  }
+
+ private:
+  bool cancelled() const { return control_.cancel && control_.cancel->load(); }
+
+  void progress(int iteration, const char* stage) {
+    if (!control_.on_progress) return;
+    RefineProgress p;
+    p.iteration = iteration;
+    p.max_iterations = options_.stopping.max_iterations;
+    p.vertices = mesh_.n_vertices();
+    p.stage = stage;
+    control_.on_progress(p);
+  }
+
+  // Thesis §5.3.4, before the flow: split/collapse against e_S, one smoothing and one
+  // regularization pass over the whole mesh.
+  void prepare() {
+    reference_edge_ = edge_stats(mesh_).shortest;
+    if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
+    apply_smoothing(mesh_, options_.smoothing);
+    apply_regularization(mesh_, options_.regularization);
+  }
+
+  // Adaptive refinement from the curvature of the previous iteration (SPEC §5); true when the
+  // topology changed. Not wired yet: the refinement stage is in progress (see the README).
+  bool adapt(int /*iteration*/, IterationReport& /*report*/, double& /*seconds*/) { return false; }
+
+  void fill_report(IterationReport& report, const EdgeStats& edges, double refinement_seconds,
+                   Clock::time_point iteration_start) {
+    report.vertices = mesh_.n_vertices();
+    report.faces = mesh_.n_faces();
+    report.sum_g = data_.total.sum_g;
+    report.defined_g = data_.total.defined_g;
+    report.moving = data_.moving;
+    report.shortest_edge = edges.shortest;
+    report.max_speed = data_.total.max_speed;
+    report.time_step = data_.time_step;
+    report.median_move = data_.median_move;
+    for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] = data_.serial_seconds[s];
+    for (const auto& slots : data_.block_seconds)  // block order: the same sum every run
+      for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] += slots[s];
+    report.stage_seconds[static_cast<int>(Stage::Refinement)] = refinement_seconds;
+    report.seconds = seconds_since(iteration_start);
+  }
+
+  void announce(const IterationReport& report) {
+    if (control_.logger)
+      control_.logger->info("iteration {:3d}  vertices {:7d}  Σg/vertex {:.6g}  Δt {:.4g}  max|F| {:.4g}  {:.3f} s",
+                            report.iteration, report.vertices, report.sum_g_per_vertex(), report.time_step,
+                            report.max_speed, report.seconds);
+    if (control_.on_iteration) control_.on_iteration(report);
+    RefineProgress p;
+    p.iteration = report.iteration;
+    p.max_iterations = options_.stopping.max_iterations;
+    p.vertices = report.vertices;
+    p.sum_g_per_vertex = report.sum_g_per_vertex();
+    p.stage = "iterating";
+    if (control_.on_progress) control_.on_progress(p);
+  }
+
+  const RefineOptions& options_;
+  const RefineControl& control_;
+  std::vector<PhotoView> views_;
+  TriMesh mesh_;
+  IterationData data_;
+  double reference_edge_ = 0.0;
+};
+
+}  // namespace
+
+RefineResult refine_mesh(const Scene& scene, const Mesh& initial, const RefineOptions& options,
+                         const RefineControl& control) {
+  const auto start = Clock::now();
+  RefineResult result;
+  try {
+    options.check();
+    if (initial.n_faces() == 0) throw InputError("the initial mesh has no faces");
+    const int threads = control.threads > 0 ? control.threads : oneapi::tbb::info::default_concurrency();
+    // The engine's own arena: the host's default arena and thread count stay untouched.
+    oneapi::tbb::task_arena arena(threads);
+    arena.execute([&] {
+      Refinement refinement(scene, initial, options, control);
+      result = refinement.run();
+    });
+  } catch (const std::exception& e) {
+    result.summary.status = RefineStatus::Failed;
+    result.summary.message = e.what();
+    result.summary.seconds = seconds_since(start);
+    if (control.logger) control.logger->error("{}", e.what());
+  }
+  return result;
+}
+
+}  // namespace mvflow

@@ -1,0 +1,138 @@
+// The refinement engine: determinism across thread counts, block sizes and engine kinds; that
+// the flow moves a synthetic initial mesh toward the ground truth; cancellation and bad input.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdio>
+
+#include "engine/refiner.h"
+#include "stages/evaluation.h"
+#include "stages/synth_scene.h"
+
+namespace mvflow {
+namespace {
+
+// A small rendered scene: bumpy sphere, 16 ring views of 320×240, a smoothed offset initial mesh.
+struct SmallScene {
+  Scene scene;
+  Mesh initial;
+  IndexedMesh truth;
+};
+
+const SmallScene& small_scene() {
+  static const SmallScene cached = [] {
+    SynthOptions options;
+    options.rig.views = 16;
+    options.rig.width = 320;
+    options.rig.height = 240;
+    options.init.vertices = 300;
+    BuiltinShapeOptions shape;
+    shape.level = 4;
+    SmallScene s;
+    s.truth = make_builtin_object("bumpy-sphere", shape);
+    SynthScene synth = make_synth_scene(s.truth, nullptr, options);
+    s.scene.views = synth.views;
+    s.scene.images = std::make_shared<ImageStore>(synth.views.size(), nullptr);
+    for (std::size_t i = 0; i < synth.images.size(); ++i) s.scene.images->set(i, std::move(synth.images[i]));
+    s.scene.bounding_box = synth.bounding_box;
+    s.initial = build_mesh(synth.initial, "initial");
+    return s;
+  }();
+  return cached;
+}
+
+// Exactly \p iterations iterations (≥ 6: the stopping rule looks back 5 iterations).
+RefineOptions few_iterations(int iterations) {
+  RefineOptions options;
+  options.stopping.max_iterations = iterations;
+  options.stopping.min_iterations = std::min(iterations, 10);
+  options.block_size = 64;
+  return options;
+}
+
+std::vector<Eigen::Vector3d> positions(const RefineResult& result) { return positions_of(result.mesh.topology); }
+
+TEST(Refiner, SameBitsForThreadsBlockSizesAndEngines) {
+  const SmallScene& s = small_scene();
+  const RefineOptions options = few_iterations(6);
+  RefineControl two, one;
+  two.threads = 2;
+  one.threads = 1;
+  const RefineResult reference = refine_mesh(s.scene, s.initial, options, two);
+  ASSERT_NE(reference.summary.status, RefineStatus::Failed) << reference.summary.message;
+  ASSERT_EQ(reference.summary.iterations.size(), 6u);
+
+  const RefineResult single = refine_mesh(s.scene, s.initial, options, one);
+  RefineOptions other_blocks = options;
+  other_blocks.block_size = 37;
+  const RefineResult blocks = refine_mesh(s.scene, s.initial, other_blocks, two);
+  RefineOptions sequential = options;
+  sequential.engine = EngineKind::Sequential;
+  const RefineResult plain = refine_mesh(s.scene, s.initial, sequential, two);
+
+  for (const RefineResult* other : {&single, &blocks, &plain}) {
+    ASSERT_EQ(other->summary.iterations.size(), reference.summary.iterations.size());
+    EXPECT_EQ(positions(*other), positions(reference));  // exact, not approximate
+    EXPECT_EQ(triangles_of(other->mesh.topology), triangles_of(reference.mesh.topology));
+    for (std::size_t i = 0; i < reference.summary.iterations.size(); ++i) {
+      EXPECT_EQ(other->summary.iterations[i].sum_g, reference.summary.iterations[i].sum_g);
+      EXPECT_EQ(other->summary.iterations[i].time_step, reference.summary.iterations[i].time_step);
+    }
+  }
+}
+
+TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = few_iterations(40);
+  options.block_size = 128;
+  const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+  EvaluationOptions evaluation;
+  evaluation.samples = 30000;
+  const EvaluationResult before = evaluate_against_truth(to_indexed(s.initial), s.truth, evaluation);
+  const EvaluationResult after = evaluate_against_truth(to_indexed(result.mesh), s.truth, evaluation);
+  std::printf("[measured] %zu iterations (%s): mean distance %.4g -> %.4g, accuracy(90%%) %.4g -> %.4g, "
+              "Σg/vertex %.4g -> %.4g, vertices %zu -> %zu, self-intersections %zu\n",
+              result.summary.iterations.size(), to_string(result.summary.status), before.symmetric_mean(),
+              after.symmetric_mean(), before.accuracy(), after.accuracy(), result.summary.initial_sum_g_per_vertex,
+              result.summary.final_sum_g_per_vertex, result.summary.initial_vertices, result.summary.final_vertices,
+              result.summary.self_intersections);
+  // Measured (this scene, 40 iterations): mean 0.0294 → 0.0241, accuracy 0.053 → 0.049. The
+  // engine issue's ≥ 50 % target needs the tuned defaults and full-size scenes; this pins the
+  // direction of the flow.
+  EXPECT_LT(after.symmetric_mean(), 0.9 * before.symmetric_mean());
+  EXPECT_LT(after.accuracy(), before.accuracy());
+  EXPECT_LT(result.summary.final_sum_g_per_vertex, result.summary.initial_sum_g_per_vertex);
+  EXPECT_EQ(result.summary.self_intersections, 0u);
+  EXPECT_EQ(result.mesh.quality.size(), result.mesh.n_vertices());
+  EXPECT_EQ(result.mesh.colors.size(), result.mesh.n_vertices());
+}
+
+TEST(Refiner, CancelStopsBetweenBlocks) {
+  const SmallScene& s = small_scene();
+  std::atomic<bool> cancel{false};
+  RefineControl control;
+  control.cancel = &cancel;
+  control.on_iteration = [&](const IterationReport& report) {
+    if (report.iteration == 2) cancel = true;
+  };
+  const RefineResult result = refine_mesh(s.scene, s.initial, few_iterations(50), control);
+  EXPECT_EQ(result.summary.status, RefineStatus::Cancelled);
+  EXPECT_EQ(result.summary.iterations.size(), 2u);
+}
+
+TEST(Refiner, BadInputIsAFailedStatusNotAnException) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = few_iterations(6);
+  options.excluded_views = {42};
+  const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
+  EXPECT_EQ(result.summary.status, RefineStatus::Failed);
+  EXPECT_NE(result.summary.message.find("excluded view 42"), std::string::npos) << result.summary.message;
+  options.excluded_views = {};
+  options.cfl = -1;
+  EXPECT_EQ(refine_mesh(s.scene, s.initial, options, {}).summary.status, RefineStatus::Failed);
+}
+
+}  // namespace
+}  // namespace mvflow

@@ -1,0 +1,172 @@
+// `mvflow refine SCENE --mesh INIT -o OUT`: the main job.
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "engine/error.h"
+#include "engine/refiner.h"
+#include "io/mesh_io.h"
+#include "io/report_io.h"
+#include "io/scene_io.h"
+#include "tools/commands.h"
+
+namespace mvflow::cli {
+
+namespace {
+
+struct RefineArguments {
+  std::string scene;
+  std::string mesh;
+  std::string output;
+  std::string report;
+  std::string preset = "default";
+  std::string engine = "graph";
+  bool ascii = false;
+  int threads = 0;
+  RefineOptions options;          // values given on the command line override the preset
+};
+
+nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
+  return {{"preset", preset},
+          {"engine", o.engine == EngineKind::Graph ? "graph" : "sequential"},
+          {"block_size", o.block_size},
+          {"velocity", o.speed.velocity},
+          {"cfl", o.cfl},
+          {"patch", 2 * o.photo.photo.half_patch + 1},
+          {"savitzky_golay_k", o.photo.savitzky_golay.k},
+          {"savitzky_golay_order", o.photo.savitzky_golay.order},
+          {"max_view_angle_degrees", o.visibility.max_angle_degrees},
+          {"curvature_area", o.curvature.area == CurvatureArea::Mixed ? "mixed" : "barycentric"},
+          {"smoothing_lambda_dt", o.smoothing.lambda_dt},
+          {"smoothing_steps", o.smoothing.steps},
+          {"regularization_strength", o.regularization.strength},
+          {"regularization_steps", o.regularization.steps},
+          {"epsilon_percent", o.stopping.epsilon_percent},
+          {"min_iterations", o.stopping.min_iterations},
+          {"max_iterations", o.stopping.max_iterations},
+          {"median_move_tolerance", o.stopping.median_move_tolerance},
+          {"excluded_views", o.excluded_views}};
+}
+
+// Starts from the preset and applies every option the user gave.
+RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
+  RefineOptions options = preset(args.preset);
+  const RefineOptions& given = args.options;
+  auto set = [&](const char* name, auto& target, const auto& value) {
+    if (command.count(name) > 0) target = value;
+  };
+  set("--block-size", options.block_size, given.block_size);
+  set("--velocity", options.speed.velocity, given.speed.velocity);
+  set("--cfl", options.cfl, given.cfl);
+  set("--max-view-angle", options.visibility.max_angle_degrees, given.visibility.max_angle_degrees);
+  set("--smoothing", options.smoothing.lambda_dt, given.smoothing.lambda_dt);
+  set("--smoothing-steps", options.smoothing.steps, given.smoothing.steps);
+  set("--regularization", options.regularization.strength, given.regularization.strength);
+  set("--regularization-steps", options.regularization.steps, given.regularization.steps);
+  set("--epsilon", options.stopping.epsilon_percent, given.stopping.epsilon_percent);
+  set("--max-iterations", options.stopping.max_iterations, given.stopping.max_iterations);
+  set("--min-iterations", options.stopping.min_iterations, given.stopping.min_iterations);
+  set("--step-tolerance", options.stopping.median_move_tolerance, given.stopping.median_move_tolerance);
+  set("--sg-k", options.photo.savitzky_golay.k, given.photo.savitzky_golay.k);
+  set("--sg-order", options.photo.savitzky_golay.order, given.photo.savitzky_golay.order);
+  if (command.count("--patch") > 0) {
+    options.photo.photo.half_patch = given.photo.photo.half_patch;
+    options.visibility.half_patch = given.photo.photo.half_patch;
+  }
+  options.excluded_views = given.excluded_views;
+  options.engine = args.engine == "sequential" ? EngineKind::Sequential : EngineKind::Graph;
+  return options;
+}
+
+int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog::logger& log) {
+  const Scene scene = io::load_scene(args.scene);
+  std::string mesh_file = args.mesh;
+  if (mesh_file.empty() && scene.mesh_file) mesh_file = scene.mesh_file->string();
+  if (mesh_file.empty()) throw InputError(args.scene, 0, "no initial mesh: pass --mesh FILE or put init.ply in the scene folder");
+  MeshBuildReport build;
+  const Mesh initial = io::load_mesh(mesh_file, &build);
+  if (build.rejected_faces > 0)
+    throw InputError(mesh_file, "face", build.first_rejected.front(),
+                     "makes the mesh non-manifold (" + std::to_string(build.rejected_faces) +
+                         " such faces); the flow needs a manifold mesh");
+
+  std::shared_ptr<spdlog::logger> shared_log(&log, [](spdlog::logger*) {});  // borrowed, not owned
+  RefineControl control;
+  control.threads = args.threads;
+  control.logger = shared_log;
+  const bool live = isatty(fileno(stderr)) != 0;
+  control.on_progress = [live](const RefineProgress& p) {
+    if (live)
+      std::fprintf(stderr, "\r\033[K%s: iteration %d/%d, %zu vertices, Σg/vertex %.5g", p.stage, p.iteration,
+                   p.max_iterations, p.vertices, p.sum_g_per_vertex);
+  };
+  log.info("refining {} ({} vertices) with {} views of {}", mesh_file, initial.n_vertices(), scene.size(),
+           scene.folder.string());
+  const RefineResult result = refine_mesh(scene, initial, options, control);
+  if (live) std::fprintf(stderr, "\r\033[K");
+  const RefineSummary& s = result.summary;
+  if (!args.report.empty()) {
+    const nlohmann::json inputs = {{"scene", scene.folder.string()}, {"mesh", mesh_file}, {"views", scene.size()},
+                                   {"threads", args.threads}};
+    io::write_report(args.report, s, inputs, options_json(options, args.preset));
+  }
+  if (s.status == RefineStatus::Failed) throw Error(s.message);
+  io::MeshWriteOptions write;
+  write.binary = !args.ascii;
+  io::write_mesh(args.output, to_indexed(result.mesh), write);
+  fmt::print("refined    {} → {} vertices in {} iterations, {:.2f} s ({})\n", s.initial_vertices, s.final_vertices,
+             s.iterations.size(), s.seconds, to_string(s.status));
+  fmt::print("Σg/vertex  {:.6g} → {:.6g}\n", s.initial_sum_g_per_vertex, s.final_sum_g_per_vertex);
+  fmt::print("mesh       {} ({} self-intersecting face pairs)\n", args.output, s.self_intersections);
+  if (!args.report.empty()) fmt::print("report     {}\n", args.report);
+  return kOk;
+}
+
+}  // namespace
+
+void add_refine_command(CLI::App& app, Runner& runner) {
+  auto args = std::make_shared<RefineArguments>();
+  CLI::App* c = app.add_subcommand("refine", "Refine a mesh toward the photo-consistent surface (the main job)");
+  RefineOptions& o = args->options;
+  c->add_option("scene", args->scene, "Scene folder, or a camera file inside one")->required();
+  c->add_option("--mesh", args->mesh, "Initial mesh (default: the scene's init.*)");
+  c->add_option("-o,--output", args->output, "Refined mesh (PLY with colour and quality = g; format by extension)")
+      ->required();
+  c->add_option("--report", args->report, "JSON report (per iteration and per stage)");
+  c->add_option("--preset", args->preset, "Parameter set: default or thesis (exactly the thesis's B.7 values)")
+      ->check(CLI::IsMember({"default", "thesis"}))
+      ->capture_default_str();
+  c->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber)->capture_default_str();
+  c->add_option("--engine", args->engine, "graph (TBB flow graph) or sequential (reference loop, one thread)")
+      ->check(CLI::IsMember({"graph", "sequential"}))
+      ->capture_default_str();
+  c->add_option("--block-size", o.block_size, "Vertices per block (graph node)")->check(CLI::PositiveNumber)->capture_default_str();
+  c->add_option("--velocity", o.speed.velocity, "Balloon velocity v of the speed g(v+H)")->capture_default_str();
+  c->add_option("--cfl", o.cfl, "CFL factor of the time step")->capture_default_str();
+  c->add_option("--patch", o.photo.photo.half_patch, "Patch half size (2 = 5×5)")->check(CLI::Range(1, 7))->capture_default_str();
+  c->add_option("--sg-k", o.photo.savitzky_golay.k, "Savitzky–Golay k (window k+1 samples per axis)")->capture_default_str();
+  c->add_option("--sg-order", o.photo.savitzky_golay.order, "Savitzky–Golay polynomial order")->capture_default_str();
+  c->add_option("--max-view-angle", o.visibility.max_angle_degrees, "Views beyond this angle to the normal are not used (degrees)")
+      ->capture_default_str();
+  c->add_option("--smoothing", o.smoothing.lambda_dt, "Curvature-normal smoothing λ·dt per step")->capture_default_str();
+  c->add_option("--smoothing-steps", o.smoothing.steps, "Smoothing steps per iteration")->capture_default_str();
+  c->add_option("--regularization", o.regularization.strength, "Tangential regularization C per step")->capture_default_str();
+  c->add_option("--regularization-steps", o.regularization.steps, "Regularization steps per iteration")->capture_default_str();
+  c->add_option("--epsilon", o.stopping.epsilon_percent, "Stop when Σg changes less than this (percent) over 5 iterations")
+      ->capture_default_str();
+  c->add_option("--min-iterations", o.stopping.min_iterations, "No stop before this iteration")->capture_default_str();
+  c->add_option("--max-iterations", o.stopping.max_iterations, "Stop after this many iterations")->capture_default_str();
+  c->add_option("--step-tolerance", o.stopping.median_move_tolerance, "Stop when the median move is below this × e_min")
+      ->capture_default_str();
+  c->add_option("--exclude-views", o.excluded_views, "0-based views not to use (held out)")->delimiter(',');
+  c->add_flag("--ascii", args->ascii, "Write PLY as ASCII");
+  c->callback([args, c, &runner] {
+    const RefineOptions options = resolve_options(*args, *c);
+    runner = [args, options](spdlog::logger& log) { return run_refine(*args, options, log); };
+  });
+}
+
+}  // namespace mvflow::cli
