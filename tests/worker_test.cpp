@@ -1,0 +1,136 @@
+// The embedding worker: jobs run in order in the background, progress, cancellation (queued
+// and running), failures that do not stop the queue, two workers at once, destruction while a
+// job runs.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include "engine/worker.h"
+#include "test_support.h"
+
+namespace mvflow {
+namespace {
+
+namespace fs = std::filesystem;
+
+WorkerOptions threads(int count) {
+  WorkerOptions options;
+  options.threads = count;
+  return options;
+}
+
+// One small rendered scene for the whole suite, made by the mvflow binary.
+class WorkerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new fs::path(fs::temp_directory_path() / "mvflow-worker-test-scene");
+    fs::remove_all(*scene_);
+    const std::string command = std::string(MVFLOW_BINARY) +
+                                " synth --views 8 --width 160 --height 120 --level 3 --init-vertices 200 -o " +
+                                scene_->string() + " > /dev/null 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*scene_);
+    delete scene_;
+  }
+  static JobSpec job(int iterations) {
+    JobSpec spec;
+    spec.scene = *scene_;
+    spec.options = preset("default");
+    spec.options.stopping.max_iterations = iterations;
+    spec.options.stopping.min_iterations = std::min(iterations, 10);
+    return spec;
+  }
+  static fs::path* scene_;
+};
+fs::path* WorkerTest::scene_ = nullptr;
+
+TEST_F(WorkerTest, RunsJobsInOrderAndReportsProgress) {
+  Worker worker(threads(2));
+  int seen = 0;
+  JobSpec first = job(6);
+  first.on_iteration = [&seen](const IterationReport&) { ++seen; };
+  const auto a = worker.submit(first);
+  const auto b = worker.submit(job(6));
+  const JobOutcome second = worker.wait(b);
+  ASSERT_TRUE(worker.try_result(a).has_value());  // a ran before b
+  EXPECT_EQ(second.state, JobState::Succeeded) << second.message;
+  EXPECT_EQ(second.summary.iterations.size(), 6u);
+  EXPECT_GT(second.mesh.n_vertices(), 0u);
+  EXPECT_EQ(seen, 6);
+  EXPECT_EQ(worker.progress(a).state, JobState::Succeeded);
+  EXPECT_EQ(worker.progress(b).iteration, 6);
+}
+
+TEST_F(WorkerTest, CancelDuringTheFirstIterationReturnsQuickly) {
+  Worker worker(threads(2));
+  const auto id = worker.submit(job(100));
+  while (worker.progress(id).state == JobState::Queued || worker.progress(id).stage == "loading")
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const auto start = std::chrono::steady_clock::now();
+  worker.cancel(id);
+  const JobOutcome outcome = worker.wait(id);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(outcome.state, JobState::Cancelled);
+  EXPECT_LT(outcome.summary.iterations.size(), 100u);
+  EXPECT_LT(seconds, 0.1);
+}
+
+TEST_F(WorkerTest, CancelWhileQueuedNeverStarts) {
+  Worker worker(threads(1));
+  const auto running = worker.submit(job(30));
+  const auto queued = worker.submit(job(30));
+  worker.cancel(queued);
+  const JobOutcome outcome = worker.wait(queued);
+  EXPECT_EQ(outcome.state, JobState::Cancelled);
+  EXPECT_TRUE(outcome.summary.iterations.empty());
+  EXPECT_EQ(worker.wait(running).state, JobState::Succeeded);
+}
+
+TEST_F(WorkerTest, BadJobFailsAndTheNextStillRuns) {
+  Worker worker;
+  JobSpec bad = job(6);
+  bad.scene = "/nonexistent/scene";
+  const auto failing = worker.submit(bad);
+  const auto good = worker.submit(job(6));
+  const JobOutcome failed = worker.wait(failing);
+  EXPECT_EQ(failed.state, JobState::Failed);
+  EXPECT_NE(failed.message.find("/nonexistent/scene"), std::string::npos) << failed.message;
+  EXPECT_EQ(worker.wait(good).state, JobState::Succeeded);
+}
+
+TEST_F(WorkerTest, TwoWorkersAtOnceGiveTheSameBits) {
+  Worker left(threads(1)), right(threads(1));
+  const auto a = left.submit(job(6));
+  const auto b = right.submit(job(6));
+  const JobOutcome x = left.wait(a), y = right.wait(b);
+  ASSERT_EQ(x.state, JobState::Succeeded);
+  ASSERT_EQ(y.state, JobState::Succeeded);
+  EXPECT_EQ(positions_of(x.mesh.topology), positions_of(y.mesh.topology));
+}
+
+TEST_F(WorkerTest, DestructionWhileRunningCancelsAndJoins) {
+  const auto start = std::chrono::steady_clock::now();
+  {
+    Worker worker;
+    worker.submit(job(100));
+    worker.submit(job(100));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }  // must not hang or crash
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+}
+
+TEST(Readme, ContainsTheEmbeddingExampleVerbatim) {
+  const std::string readme = test::read_text(fs::path(MVFLOW_SOURCE_DIR) / "README.md");
+  const std::string example = test::read_text(fs::path(MVFLOW_SOURCE_DIR) / "tests" / "embedding_example.cpp");
+  const auto body = example.substr(example.find("#include <cstdio>"));
+  EXPECT_NE(readme.find(body), std::string::npos) << "README must show tests/embedding_example.cpp from #include <cstdio> on";
+}
+
+}  // namespace
+}  // namespace mvflow
