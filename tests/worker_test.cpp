@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <thread>
 
+#include <unistd.h>
+
 #include "engine/worker.h"
 #include "test_support.h"
 
@@ -27,7 +29,8 @@ WorkerOptions threads(int count) {
 class WorkerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    scene_ = new fs::path(fs::temp_directory_path() / "mvflow-worker-test-scene");
+    // Per process: CTest runs each test of this file as its own process, possibly in parallel.
+    scene_ = new fs::path(fs::temp_directory_path() / ("mvflow-worker-test-scene-" + std::to_string(::getpid())));
     fs::remove_all(*scene_);
     const std::string command = std::string(MVFLOW_BINARY) +
                                 " synth --views 8 --width 160 --height 120 --level 3 --init-vertices 200 -o " +
