@@ -108,5 +108,35 @@ TEST(Cli, ConvertMeshAndCamerasRoundTrip) {
   EXPECT_NE(test::read_text(folder / "colmap" / "cameras.txt").find(" 80 60 "), std::string::npos);
 }
 
+TEST(Cli, BatchContinuesPastFailuresSkipsCompleteAndShards) {
+  test::ScratchFolder folder;
+  for (const char* name : {"a", "b"}) {
+    const CommandResult r = run("synth --views 6 --width 120 --height 90 --level 3 --init-vertices 120 -o " +
+                                (folder / name).string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  test::write_text(folder / "list.txt", "# two scenes and a missing one\na\nmissing\nb\n");
+  const std::string batch = "batch " + (folder / "list.txt").string() + " -o " + (folder / "out").string() +
+                            " --max-iterations 6 --threads 2";
+  CommandResult r = run(batch);
+  EXPECT_EQ(r.exit_code, 1) << r.output;  // one scene failed
+  EXPECT_TRUE(fs::exists(folder / "out" / "a" / "refined.ply"));
+  EXPECT_TRUE(fs::exists(folder / "out" / "b" / "report.json"));  // the batch went on past "missing"
+  EXPECT_NE(r.output.find("3 scene(s) in shard 0/1: 1 failed"), std::string::npos) << r.output;
+
+  // Run again: complete scenes are skipped.
+  r = run(batch);
+  EXPECT_NE(r.output.find("a                            skipped (complete)"), std::string::npos) << r.output;
+
+  // Shards split the sorted list (a, b, missing) by index mod n.
+  test::write_text(folder / "good.txt", "a\nb\n");
+  r = run("batch " + (folder / "good.txt").string() + " -o " + (folder / "sharded").string() +
+          " --max-iterations 6 --shard 1/2");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(folder / "sharded" / "a"));
+  EXPECT_TRUE(fs::exists(folder / "sharded" / "b" / "refined.ply"));
+  EXPECT_EQ(run("batch " + (folder / "good.txt").string() + " --shard 2/2").exit_code, 2);  // usage
+}
+
 }  // namespace
 }  // namespace mvflow

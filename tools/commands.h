@@ -31,4 +31,7 @@ void add_slice_command(CLI::App& app, Runner& runner);
 //! `mvflow refine SCENE --mesh FILE -o OUT [--threads N] [--report FILE.json] ...`
 void add_refine_command(CLI::App& app, Runner& runner);
 
+//! `mvflow batch LIST -o DIR [--shard i/n] [--force]`
+void add_batch_command(CLI::App& app, Runner& runner);
+
 }  // namespace mvflow::cli

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   add_convert_command(app, runner);
   add_refine_command(app, runner);
   add_eval_command(app, runner);
+  add_batch_command(app, runner);
   add_slice_command(app, runner);
   add_synth_command(app, runner);
 
