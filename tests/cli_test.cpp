@@ -4,7 +4,6 @@
 
 #include <array>
 #include <cstdio>
-#include <sys/wait.h>
 
 #include "test_support.h"
 
@@ -14,22 +13,9 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kDefaultScene = fs::path(MVFLOW_TEST_DATA) / "scenes" / "default";
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
+using test::CommandResult;
 
-CommandResult run(const std::string& arguments) {
-  const std::string command = std::string(MVFLOW_BINARY) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+CommandResult run(const std::string& arguments) { return test::run_mvflow(arguments); }
 
 TEST(Cli, VersionAndHelpExitZero) {
   EXPECT_EQ(run("--version").exit_code, 0);

@@ -16,6 +16,7 @@
 #include "stages/photo_gradient.h"
 #include "stages/synth_scene.h"
 #include "stages/visibility.h"
+#include "test_support.h"
 
 namespace mvflow {
 namespace {
@@ -165,20 +166,12 @@ TEST(PhotoConsistency, UndefinedWithFewerThanTwoUsableViews) {
   EXPECT_EQ(photo_consistency({5, 0, 0}, std::vector<std::uint16_t>{0, 1}, views).views, 0);
 }
 
-// Möller–Trumbore segment test in double: the independent occlusion reference.
+// The independent occlusion reference: the open segment from → to against every triangle.
 bool segment_hits(const IndexedMesh& mesh, const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
-  const Eigen::Vector3d d = to - from;
   for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.positions[t[0]], e1 = mesh.positions[t[1]] - a, e2 = mesh.positions[t[2]] - a;
-    const Eigen::Vector3d p = d.cross(e2);
-    const double det = e1.dot(p);
-    if (std::abs(det) < 1e-15) continue;
-    const Eigen::Vector3d s = from - a;
-    const double u = s.dot(p) / det;
-    const Eigen::Vector3d q = s.cross(e1);
-    const double v = d.dot(q) / det;
-    const double t_hit = e2.dot(q) / det;
-    if (u >= 0 && v >= 0 && u + v <= 1 && t_hit > 0 && t_hit < 1) return true;
+    const auto hit = test::ray_triangle_hit(from, to - from, mesh.positions[t[0]], mesh.positions[t[1]],
+                                            mesh.positions[t[2]]);
+    if (hit && *hit < 1) return true;
   }
   return false;
 }

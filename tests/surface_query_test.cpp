@@ -12,21 +12,11 @@
 namespace mvflow {
 namespace {
 
-// Möller–Trumbore in double: the independent reference for ray hits.
 std::optional<double> brute_force_hit(const IndexedMesh& mesh, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
   std::optional<double> best;
   for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.positions[t[0]], e1 = mesh.positions[t[1]] - a, e2 = mesh.positions[t[2]] - a;
-    const Eigen::Vector3d p = d.cross(e2);
-    const double det = e1.dot(p);
-    if (std::abs(det) < 1e-14) continue;
-    const Eigen::Vector3d s = o - a;
-    const double u = s.dot(p) / det;
-    const Eigen::Vector3d q = s.cross(e1);
-    const double v = d.dot(q) / det;
-    const double distance = e2.dot(q) / det;
-    if (u < 0 || v < 0 || u + v > 1 || distance <= 0) continue;
-    if (!best || distance < *best) best = distance;
+    const auto hit = test::ray_triangle_hit(o, d, mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]);
+    if (hit && (!best || *hit < *best)) best = hit;
   }
   return best;
 }

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
-#include <sys/wait.h>
 
 #include "engine/mesh_stats.h"
 #include "engine/surface_query.h"
@@ -303,22 +302,9 @@ TEST(Synth, OffsetInitLosesTheBumps) {
 
 // ----- the command ---------------------------------------------------------------------------
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;
-};
+using test::CommandResult;
 
-CommandResult run(const std::string& arguments) {
-  const std::string command = std::string(MVFLOW_BINARY) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+CommandResult run(const std::string& arguments) { return test::run_mvflow(arguments); }
 
 const std::string kSmall = " --views 4 --width 160 --height 120 --init-vertices 400";
 

@@ -3,8 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <Eigen/Geometry>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <fstream>
 #include <numbers>
 #include <string>
@@ -41,6 +47,43 @@ inline void write_text(const std::filesystem::path& file, const std::string& tex
 inline std::string read_text(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+//! What running the mvflow program printed (stdout and stderr together) and its exit code.
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;
+};
+
+//! Runs `mvflow ARGUMENTS` (the binary this build made) and waits for it.
+inline CommandResult run_mvflow(const std::string& arguments) {
+  const std::string command = std::string(MVFLOW_BINARY) + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) result.output += buffer.data();
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+//! Möller–Trumbore in double: where the ray origin + t·direction (t > 0) meets triangle (a, b, c),
+//! in units of |direction|; the independent reference for Embree's answers.
+inline std::optional<double> ray_triangle_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                              const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                              const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e1 = b - a, e2 = c - a;
+  const Eigen::Vector3d p = direction.cross(e2);
+  const double det = e1.dot(p);
+  if (std::abs(det) < 1e-15) return std::nullopt;
+  const Eigen::Vector3d s = origin - a;
+  const double u = s.dot(p) / det;
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = direction.dot(q) / det;
+  const double t = e2.dot(q) / det;
+  if (u < 0 || v < 0 || u + v > 1 || t <= 0) return std::nullopt;
+  return t;
 }
 
 //! The regular octahedron with vertices at ±1 on the axes, faces counter-clockwise from outside.
