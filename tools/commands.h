@@ -34,4 +34,7 @@ void add_refine_command(CLI::App& app, Runner& runner);
 //! `mvflow batch LIST -o DIR [--shard i/n] [--force]`
 void add_batch_command(CLI::App& app, Runner& runner);
 
+//! `mvflow render SCENE MESH --view I -o OUT.png [--shading shaded|colour]`
+void add_render_command(CLI::App& app, Runner& runner);
+
 }  // namespace mvflow::cli

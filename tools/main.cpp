@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   add_eval_command(app, runner);
   add_batch_command(app, runner);
   add_slice_command(app, runner);
+  add_render_command(app, runner);
   add_synth_command(app, runner);
 
   try {
