@@ -138,8 +138,11 @@ class Refinement {
       const auto iteration_start = Clock::now();
       IterationReport report;
       report.iteration = iteration;
-      double refinement_seconds = 0.0;
-      if (adapt(iteration, report, refinement_seconds) || !data_.surface) {
+      // Adaptive refinement (SPEC §5) belongs here, before the topology-dependent state is
+      // (re)built; it lands with the refinement stage (stages issue). Until then the topology
+      // is fixed after prepare(), so the graph is built once.
+      const double refinement_seconds = 0.0;
+      if (!data_.surface) {
         data_.reset_topology();
         graph.reset();
       }
@@ -198,18 +201,14 @@ class Refinement {
     control_.on_progress(p);
   }
 
-  // Thesis §5.3.4, before the flow: split/collapse against e_S, one smoothing and one
-  // regularization pass over the whole mesh.
+  // Thesis §5.3.4, before the flow: split/collapse against e_S (not yet: the remeshing stage is
+  // open in the stages issue), one smoothing and one regularization pass over the whole mesh.
   void prepare() {
     reference_edge_ = edge_stats(mesh_).shortest;
     if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
     apply_smoothing(mesh_, options_.smoothing);
     apply_regularization(mesh_, options_.regularization);
   }
-
-  // Adaptive refinement from the curvature of the previous iteration (SPEC §5); true when the
-  // topology changed. Not wired yet: the refinement stage is in progress (see the README).
-  bool adapt(int /*iteration*/, IterationReport& /*report*/, double& /*seconds*/) { return false; }
 
   void fill_report(IterationReport& report, const EdgeStats& edges, double refinement_seconds,
                    Clock::time_point iteration_start) {
