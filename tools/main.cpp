@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   add_slice_command(app, runner);
   add_render_command(app, runner);
   add_synth_command(app, runner);
+  add_subdivide_command(app, runner);
 
   try {
     app.parse(argc, argv);
