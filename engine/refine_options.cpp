@@ -15,6 +15,8 @@ void RefineOptions::check() const {
   require(smoothing.check(), "smoothing (lambda*dt in (0,1), steps >= 0)");
   require(regularization.check(), "regularization (strength in (0,1], steps >= 0)");
   require(stopping.check(), "stopping (epsilon, iterations, lookback, tolerance)");
+  require(remeshing.check(), "remeshing factors");
+  require(adaptive.check(), "adaptive refinement thresholds");
   require(block_size >= 1, "block size >= 1");
   require(photo.photo.half_patch == visibility.half_patch, "the visibility patch must equal the photo patch");
   for (int view : excluded_views) require(view >= 0, "excluded views are 0-based indices");

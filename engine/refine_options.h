@@ -6,9 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "stages/adaptive_refinement.h"
 #include "stages/curvature.h"
 #include "stages/photo_gradient.h"
 #include "stages/regularization.h"
+#include "stages/remeshing.h"
 #include "stages/smoothing.h"
 #include "stages/speed.h"
 #include "stages/stopping.h"
@@ -31,6 +33,10 @@ struct RefineOptions {
   SmoothingOptions smoothing;
   RegularizationOptions regularization;
   StoppingOptions stopping;
+  bool global_remeshing = true;        //!< split/collapse once before the flow (SPEC §5)
+  RemeshingOptions remeshing;
+  bool adaptive_refinement = true;     //!< quadrisect high-curvature regions between iterations
+  AdaptiveRefinementOptions adaptive;
   //! Vertices per block (one graph node per block and stage). 128: on the default scene (800
   //! vertices) 2 threads ran 1.76× faster than 1 with 128 and not at all faster with 1024 (one
   //! block); at 10k vertices 64, 128 and 512 all gave 1.93× (README, "Performance").

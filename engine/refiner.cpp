@@ -12,9 +12,11 @@
 #include "engine/error.h"
 #include "engine/iteration.h"
 #include "engine/iteration_graph.h"
+#include "stages/adaptive_refinement.h"
 #include "stages/normals.h"
 #include "stages/photo_consistency.h"
 #include "stages/regularization.h"
+#include "stages/remeshing.h"
 #include "stages/self_intersections.h"
 #include "stages/smoothing.h"
 #include "stages/visibility.h"
@@ -138,11 +140,8 @@ class Refinement {
       const auto iteration_start = Clock::now();
       IterationReport report;
       report.iteration = iteration;
-      // Adaptive refinement (SPEC §5) belongs here, before the topology-dependent state is
-      // (re)built; it lands with the refinement stage (stages issue). Until then the topology
-      // is fixed after prepare(), so the graph is built once.
-      const double refinement_seconds = 0.0;
-      if (!data_.surface) {
+      double refinement_seconds = 0.0;
+      if (adapt(iteration, report, refinement_seconds) || !data_.surface) {
         data_.reset_topology();
         graph.reset();
       }
@@ -201,13 +200,26 @@ class Refinement {
     control_.on_progress(p);
   }
 
-  // Thesis §5.3.4, before the flow: split/collapse against e_S (not yet: the remeshing stage is
-  // open in the stages issue), one smoothing and one regularization pass over the whole mesh.
+  // Thesis §5.3.4, before the flow: split/collapse against e_S, one smoothing and one
+  // regularization pass over the whole mesh.
   void prepare() {
     reference_edge_ = edge_stats(mesh_).shortest;
     if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
+    if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
     apply_smoothing(mesh_, options_.smoothing);
     apply_regularization(mesh_, options_.regularization);
+  }
+
+  // Adaptive refinement from the curvature of the previous iteration (SPEC §5). True when the
+  // topology changed, so the blocks, fields, Embree scene and graph are rebuilt.
+  bool adapt(int iteration, IterationReport& report, double& seconds) {
+    if (!options_.adaptive_refinement || iteration == 1) return false;
+    const auto start = Clock::now();
+    const std::size_t faces = mesh_.n_faces();
+    refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive);
+    report.refined_faces = mesh_.n_faces() - faces;
+    seconds = seconds_since(start);
+    return mesh_.n_faces() != faces;
   }
 
   void fill_report(IterationReport& report, const EdgeStats& edges, double refinement_seconds,

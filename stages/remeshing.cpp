@@ -24,26 +24,44 @@ namespace {
 using VertexHandle = TriMesh::VertexHandle;
 using HalfedgeHandle = TriMesh::HalfedgeHandle;
 
+//! Σ (Q−P)×(R−P) over the faces (P, Q, R) around \p v: twice the area-weighted normal of its ring.
+Eigen::Vector3d area_normal(const TriMesh& mesh, VertexHandle v) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d p = detail::point(mesh, v);
+  for (auto h = mesh.cvoh_iter(v); h.is_valid(); ++h) {
+    if (!mesh.face_handle(*h).is_valid()) continue;
+    const Eigen::Vector3d q = detail::point(mesh, mesh.to_vertex_handle(*h));
+    const Eigen::Vector3d r = detail::point(mesh, mesh.to_vertex_handle(mesh.next_halfedge_handle(*h)));
+    sum += (q - p).cross(r - p);
+  }
+  return sum;
+}
+
 enum class Verdict { Ok, FoldOver, LongEdge };
 
 //! Would moving both ends of the collapsed edge to \p target keep every surviving face around
-//! \p moved (one of the two ends) unflipped and non-degenerate, and every edge at it ≤ \p max_edge?
-//! \p other is the other end; faces containing both ends vanish with the collapse and are skipped.
+//! \p moved (one of the two ends) non-degenerate and unflipped, and every edge at it ≤ \p max_edge?
+//! Unflipped: the face's new normal has a positive dot product with its old normal and with
+//! \p ring_normal, the area-weighted normal of both ends' rings before the collapse. The second
+//! test stops a face from turning over in several steps of < 90° each (seen when most edges of a
+//! sphere were collapse candidates). \p other is the other end; faces containing both ends vanish
+//! with the collapse and are skipped.
 Verdict check_ring(const TriMesh& mesh, VertexHandle moved, VertexHandle other, const Eigen::Vector3d& target,
-                   double max_edge) {
+                   const Eigen::Vector3d& ring_normal, double max_edge) {
+  const Eigen::Vector3d p = detail::point(mesh, moved);
   for (auto h = mesh.cvoh_iter(moved); h.is_valid(); ++h) {
     const VertexHandle q = mesh.to_vertex_handle(*h);
     if (q == other) continue;
-    if ((detail::point(mesh, q) - target).norm() > max_edge) return Verdict::LongEdge;
+    const Eigen::Vector3d pq = detail::point(mesh, q);
+    if ((pq - target).norm() > max_edge) return Verdict::LongEdge;
     if (!mesh.face_handle(*h).is_valid()) continue;
-    // Face (moved, q, r), counter-clockwise.
-    const VertexHandle r = mesh.to_vertex_handle(mesh.next_halfedge_handle(*h));
+    const VertexHandle r = mesh.to_vertex_handle(mesh.next_halfedge_handle(*h));  // face (moved, q, r)
     if (r == other) continue;
-    const Eigen::Vector3d p = detail::point(mesh, moved);
-    const Eigen::Vector3d pq = detail::point(mesh, q), pr = detail::point(mesh, r);
+    const Eigen::Vector3d pr = detail::point(mesh, r);
     const Eigen::Vector3d before = (pq - p).cross(pr - p);
     const Eigen::Vector3d after = (pq - target).cross(pr - target);
-    if (detail::is_degenerate(target, pq, pr, after) || !(before.normalized().dot(after.normalized()) > 0.5)) return Verdict::FoldOver;
+    if (detail::is_degenerate(target, pq, pr, after) || !(before.dot(after) > 0.0) || !(ring_normal.dot(after) > 0.0))
+      return Verdict::FoldOver;
   }
   return Verdict::Ok;
 }
@@ -93,8 +111,9 @@ void collapse_short_edges(TriMesh& mesh, double lower, double upper, RemeshingRe
     const Eigen::Vector3d target = (from_boundary || to_boundary)
                                        ? detail::point(mesh, to)
                                        : 0.5 * (detail::point(mesh, from) + detail::point(mesh, to));
-    Verdict verdict = check_ring(mesh, from, to, target, upper);
-    if (verdict == Verdict::Ok) verdict = check_ring(mesh, to, from, target, upper);
+    const Eigen::Vector3d ring_normal = area_normal(mesh, from) + area_normal(mesh, to);
+    Verdict verdict = check_ring(mesh, from, to, target, ring_normal, upper);
+    if (verdict == Verdict::Ok) verdict = check_ring(mesh, to, from, target, ring_normal, upper);
     if (verdict != Verdict::Ok) {
       ++(verdict == Verdict::FoldOver ? result.rejected_fold_over : result.rejected_long_edge);
       continue;

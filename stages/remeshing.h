@@ -41,8 +41,9 @@ struct RemeshingResult {
 //!     the other end is interior — unless that would (a) collapse a boundary edge or an interior
 //!     edge between two boundary vertices, (b) break manifoldness (OpenMesh is_collapse_ok, the
 //!     link condition), (c) flip or degenerate a face around the merged vertex (its normal must keep
-//!     a positive dot product with the old one), or (d) make an edge at the merged vertex longer
-//!     than b_u. Boundary vertices therefore never move.
+//!     a positive dot product with its old normal and with the area-weighted normal of the two
+//!     ends' rings), or (d) make an edge at the merged vertex longer than b_u. Boundary vertices
+//!     therefore never move.
 //! One pass each, as the thesis ("the two operators are used only once") and SPEC §5 say, so the
 //! bounds b_l ≤ |e| ≤ b_u are not guaranteed afterwards. What can remain:
 //!  - longer than b_u: halves of edges longer than 2·b_u, and the new edges from a midpoint to

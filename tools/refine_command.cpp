@@ -25,6 +25,8 @@ struct RefineArguments {
   std::string preset = "default";
   std::string engine = "graph";
   bool ascii = false;
+  bool no_remeshing = false;
+  bool no_adaptive = false;
   int threads = 0;
   RefineOptions options;          // values given on the command line override the preset
 };
@@ -48,6 +50,8 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"min_iterations", o.stopping.min_iterations},
           {"max_iterations", o.stopping.max_iterations},
           {"median_move_tolerance", o.stopping.median_move_tolerance},
+          {"global_remeshing", o.global_remeshing},
+          {"adaptive_refinement", o.adaptive_refinement},
           {"excluded_views", o.excluded_views}};
 }
 
@@ -76,6 +80,8 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
     options.photo.photo.half_patch = given.photo.photo.half_patch;
     options.visibility.half_patch = given.photo.photo.half_patch;
   }
+  if (args.no_remeshing) options.global_remeshing = false;
+  if (args.no_adaptive) options.adaptive_refinement = false;
   options.excluded_views = given.excluded_views;
   options.engine = args.engine == "sequential" ? EngineKind::Sequential : EngineKind::Graph;
   return options;
@@ -161,6 +167,8 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--max-iterations", o.stopping.max_iterations, "Stop after this many iterations")->capture_default_str();
   c->add_option("--step-tolerance", o.stopping.median_move_tolerance, "Stop when the median move is below this × e_min")
       ->capture_default_str();
+  c->add_flag("--no-remeshing", args->no_remeshing, "Skip the global split/collapse before the flow");
+  c->add_flag("--no-adaptive", args->no_adaptive, "Skip adaptive refinement between iterations");
   c->add_option("--exclude-views", o.excluded_views, "0-based views not to use (held out)")->delimiter(',');
   c->add_flag("--ascii", args->ascii, "Write PLY as ASCII");
   c->callback([args, c, &runner] {
