@@ -6,6 +6,21 @@
 
 namespace mvflow {
 
+EdgeLengths edge_lengths(const TriMesh& mesh) {
+  EdgeLengths lengths;
+  if (mesh.n_edges() == 0) return lengths;
+  lengths.shortest = std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (auto e : mesh.edges()) {
+    const double length = mesh.calc_edge_length(e);
+    lengths.shortest = std::min(lengths.shortest, length);
+    lengths.longest = std::max(lengths.longest, length);
+    sum += length;
+  }
+  lengths.mean = sum / static_cast<double>(mesh.n_edges());
+  return lengths;
+}
+
 MeshStats compute_mesh_stats(const Mesh& mesh) {
   const TriMesh& m = mesh.topology;
   MeshStats s;
@@ -13,17 +28,11 @@ MeshStats compute_mesh_stats(const Mesh& mesh) {
   s.faces = m.n_faces();
   s.edges = m.n_edges();
 
-  double sum = 0.0;
-  s.shortest_edge = std::numeric_limits<double>::infinity();
-  for (auto e : m.edges()) {
-    const double length = m.calc_edge_length(e);
-    s.shortest_edge = std::min(s.shortest_edge, length);
-    s.longest_edge = std::max(s.longest_edge, length);
-    sum += length;
-    if (m.is_boundary(e)) ++s.boundary_edges;
-  }
-  if (s.edges == 0) s.shortest_edge = 0.0;
-  s.mean_edge = s.edges ? sum / static_cast<double>(s.edges) : 0.0;
+  const EdgeLengths lengths = edge_lengths(m);
+  s.shortest_edge = lengths.shortest;
+  s.longest_edge = lengths.longest;
+  s.mean_edge = lengths.mean;
+  for (auto e : m.edges()) s.boundary_edges += m.is_boundary(e);
 
   std::size_t used_vertices = 0;
   for (auto v : m.vertices()) {

@@ -30,4 +30,12 @@ struct MeshStats {
 
 MeshStats compute_mesh_stats(const Mesh& mesh);
 
+//! Shortest, longest and mean edge length (all 0 for a mesh without edges).
+struct EdgeLengths {
+  double shortest = 0.0;
+  double longest = 0.0;
+  double mean = 0.0;
+};
+EdgeLengths edge_lengths(const TriMesh& mesh);
+
 }  // namespace mvflow

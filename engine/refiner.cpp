@@ -12,6 +12,7 @@
 #include "engine/error.h"
 #include "engine/iteration.h"
 #include "engine/iteration_graph.h"
+#include "engine/mesh_stats.h"
 #include "stages/adaptive_refinement.h"
 #include "stages/normals.h"
 #include "stages/photo_consistency.h"
@@ -29,22 +30,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-struct EdgeStats {
-  double shortest = 0.0;
-  double mean = 0.0;
-};
-
-EdgeStats edge_stats(const TriMesh& mesh) {
-  EdgeStats stats{std::numeric_limits<double>::infinity(), 0.0};
-  for (auto e : mesh.edges()) {
-    const double length = mesh.calc_edge_length(e);
-    stats.shortest = std::min(stats.shortest, length);
-    stats.mean += length;
-  }
-  stats.mean /= static_cast<double>(std::max<std::size_t>(1, mesh.n_edges()));
-  return stats;
 }
 
 // The views the refinement may use, in scene order without the excluded ones.
@@ -77,7 +62,7 @@ SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>&
   const IndexRange all{0, static_cast<std::uint32_t>(mesh.n_vertices())};
   compute_normals(mesh, all, fields);
   const SurfaceQuery surface(mesh);
-  compute_visibility(mesh, all, views, surface, edge_stats(mesh).mean, options.visibility, fields);
+  compute_visibility(mesh, all, views, surface, edge_lengths(mesh).mean, options.visibility, fields);
   compute_photo_consistency(mesh, all, views, options.photo.photo, fields);
   SurfaceState state;
   state.g.resize(mesh.n_vertices(), 0.0f);
@@ -145,7 +130,7 @@ class Refinement {
         data_.reset_topology();
         graph.reset();
       }
-      const EdgeStats edges = edge_stats(mesh_);
+      const EdgeLengths edges = edge_lengths(mesh_);
       data_.shortest_edge = edges.shortest;
       data_.mean_edge = edges.mean;
       data_.sample_spacing = data_.photo.sample_spacing(edges.shortest);
@@ -203,7 +188,7 @@ class Refinement {
   // Thesis §5.3.4, before the flow: split/collapse against e_S, one smoothing and one
   // regularization pass over the whole mesh.
   void prepare() {
-    reference_edge_ = edge_stats(mesh_).shortest;
+    reference_edge_ = edge_lengths(mesh_).shortest;
     if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
     if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
     apply_smoothing(mesh_, options_.smoothing);
@@ -222,7 +207,7 @@ class Refinement {
     return mesh_.n_faces() != faces;
   }
 
-  void fill_report(IterationReport& report, const EdgeStats& edges, double refinement_seconds,
+  void fill_report(IterationReport& report, const EdgeLengths& edges, double refinement_seconds,
                    Clock::time_point iteration_start) {
     report.vertices = mesh_.n_vertices();
     report.faces = mesh_.n_faces();

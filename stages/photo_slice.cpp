@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "engine/error.h"
+#include "engine/mesh_stats.h"
 #include "engine/surface_query.h"
 #include "stages/normals.h"
 
@@ -67,10 +68,7 @@ PhotoSlice compute_photo_slice(const TriMesh& mesh, const std::vector<PhotoView>
     fields.resize(mesh.n_vertices(), views.size());
     const IndexRange everything{0, static_cast<std::uint32_t>(mesh.n_vertices())};
     compute_normals(mesh, everything, fields);
-    double mean_edge = 0;
-    for (auto e : mesh.edges()) mean_edge += mesh.calc_edge_length(e);
-    mean_edge /= static_cast<double>(std::max<std::size_t>(1, mesh.n_edges()));
-    compute_visibility(mesh, everything, views, surface, mean_edge, options.visibility, fields);
+    compute_visibility(mesh, everything, views, surface, edge_lengths(mesh).mean, options.visibility, fields);
   }
 
   tbb::parallel_for(0, slice.height, [&](int j) {
