@@ -56,6 +56,7 @@ void IterationData::geometry(std::size_t block) {
   StageTimer timer(block_seconds[block][static_cast<int>(Stage::Geometry)]);
   compute_normals(mesh, blocks[block], fields);
   compute_mean_curvature(mesh, blocks[block], fields, options.curvature);
+  compute_local_edges(mesh, blocks[block], fields);
 }
 
 void IterationData::visibility(std::size_t block) {
@@ -83,16 +84,22 @@ void IterationData::cfl() {
   for (std::size_t v = 0; v < fields.size(); ++v)
     if (fields.defined[v] & kPhotoDefined) sum_g += fields.photo_consistency[v];
   total.sum_g = sum_g;
-  time_step = cfl_time_step(shortest_edge, total.max_speed, options.cfl);
+  const double reference_speed =
+      options.speed_quantile < 1.0 ? speed_quantile(mesh, fields, options.speed_quantile) : total.max_speed;
+  const double step_edge = options.local_step ? mean_edge : shortest_edge;
+  time_step = cfl_time_step(step_edge, reference_speed, options.cfl);
+  const double cfl_fraction = cfl_time_step(1.0, 1.0, options.cfl);  // Δt·|F| / edge at the CFL bound
+  move_limit = options.local_step ? MoveLimit{.local_edge_fraction = cfl_fraction}
+                                  : MoveLimit{.distance = cfl_fraction * shortest_edge};
   moving = 0;
   for (std::uint8_t bits : fields.defined) moving += (bits & kSpeedDefined) != 0;
-  median_move = shortest_edge > 0 ? time_step * median_speed(mesh, fields) / shortest_edge : 0.0;
+  median_move = std::min(time_step * median_speed(mesh, fields), cfl_fraction * step_edge) / shortest_edge;
 }
 
 void IterationData::move(std::size_t block) {
   if (cancelled()) return;
   StageTimer timer(block_seconds[block][static_cast<int>(Stage::Move)]);
-  move_vertices(mesh, blocks[block], fields, time_step);
+  move_vertices(mesh, blocks[block], fields, time_step, move_limit);
 }
 
 void IterationData::smooth(std::size_t block) {

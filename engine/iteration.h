@@ -50,6 +50,7 @@ struct IterationData {
   // Set by the CFL kernel.
   BlockPartial total;
   double time_step = 0.0;
+  MoveLimit move_limit;      //!< the CFL bound on one vertex's move
   double median_move = 0.0;  //!< in units of e_min
   std::size_t moving = 0;
   double serial_seconds[kStageCount] = {};

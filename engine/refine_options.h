@@ -24,19 +24,40 @@ enum class EngineKind {
   Sequential  //!< the same per-block stage functions in a plain loop on the calling thread
 };
 
+//! When adaptive refinement runs.
+enum class RefinementSchedule {
+  EveryIteration,  //!< before every iteration but the first (thesis §5.3.4)
+  //! Coarse to fine: when the flow has converged at the current resolution (the Converged or
+  //! StepSmall rule fires), then the stopping rules start afresh; the run ends when they fire
+  //! and refinement adds nothing. README, "Defaults and differences".
+  AtConvergence,
+};
+
 struct RefineOptions {
   CurvatureOptions curvature;
   VisibilityOptions visibility;
   PhotoGradientOptions photo;          //!< Savitzky–Golay window and the photo-consistency patch
   SpeedOptions speed;                  //!< balloon velocity v
-  double cfl = 1.0;                    //!< Δt = cfl·(e_min/2)/(√3·max|F|) (SPEC §4; thesis 1)
+  double cfl = 1.0;                    //!< Δt = cfl·(e_min/2)/(√3·|F|_q) (SPEC §4; thesis 1)
+  //! q, the quantile of |F| over the moving vertices that sets Δt; in (0, 1]. 1 = max|F|, the
+  //! thesis's CFL rule. Below 1, vertices faster than |F|_q move the CFL distance
+  //! cfl·e_min/(2√3) along F, no more, so no vertex ever moves farther than under the thesis's rule.
+  double speed_quantile = 1.0;
+  //! Local CFL: Δt uses the mean edge instead of the shortest, and each vertex moves at most
+  //! cfl/(2√3) of its own shortest edge, so one short edge slows only its own vertices. false:
+  //! the thesis's global rule (every vertex moves at most cfl·e_min/(2√3)).
+  bool local_step = false;
   SmoothingOptions smoothing;
   RegularizationOptions regularization;
   StoppingOptions stopping;
   bool global_remeshing = true;        //!< split/collapse once before the flow (SPEC §5)
+  //! e_S, the reference edge of split/collapse and adaptive refinement, is this quantile of the
+  //! initial mesh's edge lengths; in [0, 1]. 0 = the shortest edge (thesis B.7).
+  double reference_edge_quantile = 0.0;
   RemeshingOptions remeshing;
   bool adaptive_refinement = true;     //!< quadrisect high-curvature regions between iterations
   AdaptiveRefinementOptions adaptive;
+  RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration
   //! Vertices per block (one graph node per block and stage). 128: on the default scene (800
   //! vertices) 2 threads ran 1.76× faster than 1 with 128 and not at all faster with 1024 (one
   //! block); at 10k vertices 64, 128 and 512 all gave 1.93× (README, "Performance").

@@ -21,7 +21,9 @@ struct IterationReport {
   int iteration = 0;                  //!< 1-based
   std::size_t vertices = 0;
   std::size_t faces = 0;
-  std::size_t refined_faces = 0;      //!< faces split by adaptive refinement before this iteration
+  //! faces added by adaptive refinement: before this iteration (schedule EveryIteration), or
+  //! after it when its stop says "refined (…)" (AtConvergence)
+  std::size_t refined_faces = 0;
   double sum_g = 0.0;                 //!< Σ g over vertices with defined g (the stopping criterion's G_i)
   std::size_t defined_g = 0;          //!< vertices with defined g
   std::size_t moving = 0;             //!< vertices with a defined speed

@@ -9,6 +9,7 @@
 #include <limits>
 #include <span>
 
+#include "engine/bounding_box.h"
 #include "engine/error.h"
 #include "engine/iteration.h"
 #include "engine/iteration_graph.h"
@@ -115,7 +116,6 @@ class Refinement {
     summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, views_, options_).sum_g_per_vertex;
 
     StoppingCriterion stopping(options_.stopping);
-    std::unique_ptr<IterationGraph> graph;
     RefineStatus status = RefineStatus::MaxIterations;
     for (int iteration = 1;; ++iteration) {
       if (cancelled()) {
@@ -126,9 +126,10 @@ class Refinement {
       IterationReport report;
       report.iteration = iteration;
       double refinement_seconds = 0.0;
-      if (adapt(iteration, report, refinement_seconds) || !data_.surface) {
+      const bool refine_now = options_.refinement_schedule == RefinementSchedule::EveryIteration && iteration > 1;
+      if ((refine_now && adapt(report, refinement_seconds)) || !data_.surface) {
         data_.reset_topology();
-        graph.reset();
+        graph_.reset();
       }
       const EdgeLengths edges = edge_lengths(mesh_);
       data_.shortest_edge = edges.shortest;
@@ -138,8 +139,8 @@ class Refinement {
       for (auto& slots : data_.block_seconds) slots.fill(0.0);
 
       if (options_.engine == EngineKind::Graph) {
-        if (!graph) graph = std::make_unique<IterationGraph>(data_);  // inside the arena: attaches to it
-        graph->run();
+        if (!graph_) graph_ = std::make_unique<IterationGraph>(data_);  // inside the arena: attaches to it
+        graph_->run();
       } else {
         run_iteration_sequential(data_);
       }
@@ -148,8 +149,13 @@ class Refinement {
         break;
       }
       fill_report(report, edges, refinement_seconds, iteration_start);
-      const StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move);
+      StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move);
       report.stop = to_string(reason);
+      const bool budget_left = stopping.iterations() < static_cast<std::size_t>(options_.stopping.max_iterations);
+      if (budget_left && refine_at_convergence(reason, report)) {
+        stopping.restart();
+        reason = StopReason::Continue;
+      }
       summary.iterations.push_back(report);
       announce(report);
       if (reason != StopReason::Continue) {
@@ -188,23 +194,40 @@ class Refinement {
   // Thesis §5.3.4, before the flow: split/collapse against e_S, one smoothing and one
   // regularization pass over the whole mesh.
   void prepare() {
-    reference_edge_ = edge_lengths(mesh_).shortest;
+    reference_edge_ = edge_length_quantile(mesh_, options_.reference_edge_quantile);
+    BoundingBox box;
+    for (auto v : mesh_.vertices()) box.extend(to_eigen(mesh_.point(v)));
+    pixel_size_ = finest_pixel_size(views_, box.centre());
     if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
     if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
     apply_smoothing(mesh_, options_.smoothing);
     apply_regularization(mesh_, options_.regularization);
   }
 
-  // Adaptive refinement from the curvature of the previous iteration (SPEC §5). True when the
+  // Adaptive refinement from the curvature of the last iteration (SPEC §5). True when the
   // topology changed, so the blocks, fields, Embree scene and graph are rebuilt.
-  bool adapt(int iteration, IterationReport& report, double& seconds) {
-    if (!options_.adaptive_refinement || iteration == 1) return false;
+  bool adapt(IterationReport& report, double& seconds) {
+    if (!options_.adaptive_refinement) return false;
     const auto start = Clock::now();
     const std::size_t faces = mesh_.n_faces();
-    refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive);
-    report.refined_faces = mesh_.n_faces() - faces;
-    seconds = seconds_since(start);
+    refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
+    report.refined_faces += mesh_.n_faces() - faces;
+    seconds += seconds_since(start);
     return mesh_.n_faces() != faces;
+  }
+
+  // The coarse-to-fine schedule: when the flow has settled at this resolution, refine; true when
+  // that changed the mesh (the run goes on at the finer resolution), recorded in \p report.
+  bool refine_at_convergence(StopReason reason, IterationReport& report) {
+    if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
+    if (reason != StopReason::Converged && reason != StopReason::StepSmall) return false;
+    double seconds = 0.0;
+    if (!adapt(report, seconds)) return false;
+    report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
+    report.stop = std::string("refined (") + to_string(reason) + ")";
+    data_.reset_topology();
+    graph_.reset();
+    return true;
   }
 
   void fill_report(IterationReport& report, const EdgeLengths& edges, double refinement_seconds,
@@ -246,6 +269,8 @@ class Refinement {
   TriMesh mesh_;
   IterationData data_;
   double reference_edge_ = 0.0;
+  double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
+  std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
 };
 
 }  // namespace

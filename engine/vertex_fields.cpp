@@ -14,6 +14,7 @@ void VertexFields::resize(std::size_t n_vertices, std::size_t n_views) {
   photo_consistency.assign(n_vertices, 0.0);
   photo_gradient.assign(n_vertices, Eigen::Vector3d::Zero());
   speed.assign(n_vertices, Eigen::Vector3d::Zero());
+  local_edge.assign(n_vertices, 0.0);
   defined.assign(n_vertices, 0);
   view_capacity = n_views;
   visible_views.assign(n_vertices * n_views, 0);

@@ -30,6 +30,7 @@ struct VertexFields {
   std::vector<double> photo_consistency;     //!< g
   std::vector<Eigen::Vector3d> photo_gradient;  //!< ∇g
   std::vector<Eigen::Vector3d> speed;        //!< F
+  std::vector<double> local_edge;            //!< shortest edge at the vertex (the local CFL length)
   std::vector<std::uint8_t> defined;         //!< VertexDefined bits
   //! Visible views of vertex v: visible_views[v·view_capacity + 0 .. visible_count[v]-1].
   std::vector<std::uint16_t> visible_views;

@@ -1,5 +1,6 @@
 #include "stages/adaptive_refinement.h"
 
+#include <algorithm>
 #include <array>
 #include <cassert>
 #include <cmath>
@@ -14,8 +15,8 @@
 namespace mvflow {
 
 bool AdaptiveRefinementOptions::check() const {
-  return std::isfinite(curvature_factor) && std::isfinite(min_edge_relative) && curvature_factor > 0.0 &&
-         min_edge_relative >= 0.0;
+  return std::isfinite(curvature_factor) && std::isfinite(min_edge_relative) && std::isfinite(min_edge_pixels) &&
+         curvature_factor > 0.0 && min_edge_relative >= 0.0 && min_edge_pixels >= 0.0;
 }
 
 namespace {
@@ -91,7 +92,8 @@ std::size_t close_red(const TriMesh& mesh, Marks& marks) {
 }  // namespace
 
 RefinementResult refine_adaptively(TriMesh& mesh, const VertexFields& fields, double reference_edge,
-                                   const AdaptiveRefinementOptions& options) {
+                                   const AdaptiveRefinementOptions& options, double pixel_size) {
+  MVFLOW_CHECK(pixel_size >= 0.0 && std::isfinite(pixel_size), "refine_adaptively: pixel size must be >= 0");
   MVFLOW_CHECK(options.check(), "refine_adaptively: invalid AdaptiveRefinementOptions");
   MVFLOW_CHECK(std::isfinite(reference_edge) && reference_edge > 0.0,
                "refine_adaptively: the reference edge e_S must be positive and finite");
@@ -102,7 +104,8 @@ RefinementResult refine_adaptively(TriMesh& mesh, const VertexFields& fields, do
   RefinementResult result;
   Marks marks{std::vector<std::uint8_t>(mesh.n_faces(), 0), std::vector<std::uint8_t>(mesh.n_edges(), 0)};
   const double threshold = options.curvature_factor * reference_edge;
-  const double min_edge = options.min_edge_relative * bounding_box_diagonal(mesh);
+  const double min_edge =
+      std::max(options.min_edge_relative * bounding_box_diagonal(mesh), options.min_edge_pixels * pixel_size);
   result.marked_vertices = mark_red(mesh, fields, threshold, min_edge, marks);
   result.promoted_faces = close_red(mesh, marks);
 

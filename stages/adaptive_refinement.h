@@ -17,6 +17,11 @@ struct AdaptiveRefinementOptions {
   //! min_edge_relative × the bounding-box diagonal of the mesh. 1e-3: thesis B.4 (absolute 1e−3
   //! there; relative here, SPEC §9). ≥ 0.
   double min_edge_relative = 1e-3;
+  //! ... and longer than min_edge_pixels × the pixel size at the object (the world length one
+  //! pixel of the finest view covers there): below the footprint of the 5×5 photo-consistency
+  //! patch the photographs cannot place the new vertices. 5 (the patch width); 0 in the thesis
+  //! preset. ≥ 0. See the README, "Defaults and differences", for the measurement.
+  double min_edge_pixels = 5.0;
 
   //! True when both values are finite, curvature_factor > 0 and min_edge_relative ≥ 0.
   bool check() const;
@@ -35,7 +40,7 @@ struct RefinementResult {
 //!  1. Mark: every vertex v with kCurvatureDefined whose fields.curvature_normal_length[v]
 //!     exceeds options.curvature_factor · e_S. Every face around a marked vertex whose three
 //!     edges are all longer than options.min_edge_relative · (bounding-box diagonal of \p mesh)
-//!     becomes red.
+//!     and than options.min_edge_pixels · pixel_size becomes red.
 //!  2. Close (red–green, Bank et al. 1983): every edge of a red face is split. A face that is not
 //!     red but has two or three split edges is promoted to red, repeated until nothing changes
 //!     (the fixed point does not depend on the visiting order). Promotion ignores the
@@ -60,6 +65,8 @@ struct RefinementResult {
 //!                       positions; not resized here.
 //! \param reference_edge e_S, the shortest edge of the initial mesh (world units), > 0.
 //! \param options        Checked with check().
+//! \param pixel_size     World length of one pixel at the object (photo_views.h:
+//!                       finest_pixel_size); 0 when unknown (min_edge_pixels then has no effect).
 //! \pre \p mesh has no deleted elements (ids contiguous); fields.size() == #V.
 //! \post Vertex ids 0..#V−1 keep their vertices and positions; the midpoints follow as
 //!       #V..#V+new_vertices−1 in the id order of the edges they split. Faces that were not
@@ -70,6 +77,6 @@ struct RefinementResult {
 //!        fields are not sized for the mesh, or OpenMesh rejects a child face (an internal
 //!        invariant that would leave the mesh partly rebuilt; never seen on manifold input).
 RefinementResult refine_adaptively(TriMesh& mesh, const VertexFields& fields, double reference_edge,
-                                   const AdaptiveRefinementOptions& options = {});
+                                   const AdaptiveRefinementOptions& options = {}, double pixel_size = 0.0);
 
 }  // namespace mvflow

@@ -18,6 +18,19 @@ std::vector<PhotoView> make_photo_views(const std::vector<Camera>& cameras, cons
   return views;
 }
 
+double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vector3d& point) {
+  double finest = 0.0;
+  for (const PhotoView& view : views) {
+    const Camera& camera = *view.camera;
+    const double depth = (camera.R() * point + camera.t()).z();
+    const double focal = 0.5 * (camera.K()(0, 0) + camera.K()(1, 1));
+    if (!(depth > 0) || !(focal > 0)) continue;
+    const double size = depth / focal;
+    if (finest == 0.0 || size < finest) finest = size;
+  }
+  return finest;
+}
+
 std::vector<PhotoView> make_photo_views(const Scene& scene) {
   std::vector<PhotoView> views(scene.size());
   for (std::size_t i = 0; i < scene.size(); ++i) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "stages/one_ring.h"
 
@@ -68,24 +69,60 @@ double cfl_time_step(double shortest_edge, double max_speed, double cfl) {
   return cfl * (0.5 * shortest_edge) / (std::sqrt(3.0) * max_speed);
 }
 
-void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt) {
+void compute_local_edges(const TriMesh& mesh, IndexRange vertices, VertexFields& fields) {
+  detail::check_range(vertices, mesh.n_vertices(), "compute_local_edges");
+  MVFLOW_CHECK(fields.local_edge.size() == mesh.n_vertices(), "compute_local_edges: fields are not sized for the mesh");
+  for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
+    double shortest = std::numeric_limits<double>::infinity();
+    for (auto h = mesh.cvoh_iter(detail::handle(id)); h.is_valid(); ++h)
+      shortest = std::min(shortest, mesh.calc_edge_length(*h));
+    fields.local_edge[id] = shortest;
+  }
+}
+
+void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt, const MoveLimit& limit) {
   MVFLOW_CHECK(dt >= 0.0 && std::isfinite(dt), "move_vertices: dt must be finite and >= 0");
+  MVFLOW_CHECK(limit.distance > 0.0 && limit.local_edge_fraction >= 0.0, "move_vertices: invalid move limit");
   detail::check_range(vertices, mesh.n_vertices(), "move_vertices");
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "move_vertices: fields are not sized for the mesh");
   for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
     const auto v = detail::handle(id);
     if (!(fields.defined[id] & kSpeedDefined) || mesh.is_boundary(v)) continue;
-    mesh.set_point(v, mesh.point(v) + to_openmesh(dt * fields.speed[id]));
+    Eigen::Vector3d step = dt * fields.speed[id];
+    double longest = limit.distance;
+    if (limit.local_edge_fraction > 0.0) longest = std::min(longest, limit.local_edge_fraction * fields.local_edge[id]);
+    const double length = step.norm();
+    if (length > longest) step *= longest / length;
+    mesh.set_point(v, mesh.point(v) + to_openmesh(step));
   }
 }
 
-double median_speed(const TriMesh& mesh, const VertexFields& fields) {
-  MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "median_speed: fields are not sized for the mesh");
+namespace {
+
+std::vector<double> moving_speeds(const TriMesh& mesh, const VertexFields& fields) {
+  MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "speeds: fields are not sized for the mesh");
   std::vector<double> speeds;
   speeds.reserve(fields.size());
   for (std::uint32_t id = 0; id < fields.size(); ++id)
     if ((fields.defined[id] & kSpeedDefined) && !mesh.is_boundary(detail::handle(id)))
       speeds.push_back(fields.speed[id].norm());
+  return speeds;
+}
+
+}  // namespace
+
+double speed_quantile(const TriMesh& mesh, const VertexFields& fields, double quantile) {
+  MVFLOW_CHECK(quantile > 0.0 && quantile <= 1.0, "speed_quantile: quantile must be in (0, 1]");
+  std::vector<double> speeds = moving_speeds(mesh, fields);
+  if (speeds.empty()) return 0.0;
+  const auto rank = static_cast<std::size_t>(std::ceil(quantile * static_cast<double>(speeds.size()))) - 1;
+  const auto nth = speeds.begin() + static_cast<std::ptrdiff_t>(std::min(rank, speeds.size() - 1));
+  std::nth_element(speeds.begin(), nth, speeds.end());
+  return *nth;
+}
+
+double median_speed(const TriMesh& mesh, const VertexFields& fields) {
+  std::vector<double> speeds = moving_speeds(mesh, fields);
   if (speeds.empty()) return 0.0;
   const std::size_t upper = speeds.size() / 2;
   std::nth_element(speeds.begin(), speeds.begin() + upper, speeds.end());

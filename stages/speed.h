@@ -3,6 +3,7 @@
 // and the forward Euler move (thesis 4.13, 5.3.3; SPEC §3, §4).
 
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "engine/mesh.h"
@@ -56,6 +57,18 @@ BlockPartial combine(const std::vector<BlockPartial>& partials);
 //! \throw Error for arguments out of range.
 double cfl_time_step(double shortest_edge, double max_speed, double cfl = 1.0);
 
+//! fields.local_edge[v] = the shortest edge incident to v, for v in \p vertices (+∞ for an
+//! isolated vertex). Run before any block moves, so every block reads the same positions.
+void compute_local_edges(const TriMesh& mesh, IndexRange vertices, VertexFields& fields);
+
+//! The longest move of one vertex in one step: the smaller of a distance and a fraction of the
+//! vertex's shortest incident edge (the CFL bound taken locally: a vertex that stays within a
+//! fraction of its own edges cannot fold its faces).
+struct MoveLimit {
+  double distance = std::numeric_limits<double>::infinity();  //!< world units, > 0
+  double local_edge_fraction = 0.0;  //!< × the shortest edge at the vertex; 0 = no local limit
+};
+
 //! The forward Euler update P ← P + dt·F(P) for every vertex in \p vertices with kSpeedDefined;
 //! boundary vertices never move. Writes the positions of \p vertices only: the speed was
 //! computed from the old positions of every block, so run it after all blocks' speeds.
@@ -64,11 +77,18 @@ double cfl_time_step(double shortest_edge, double max_speed, double cfl = 1.0);
 //! \param fields   Per-vertex arrays sized #V with the speed of this iteration.
 //! \param dt       The time step (cfl_time_step); ≥ 0, finite.
 //! \throw Error if dt or the sizes are invalid.
-void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt);
+//! \param limit    How far one vertex may move; a faster vertex moves that far along F. No limit
+//!                 (the default) moves every vertex by dt·F, as the thesis does.
+void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt,
+                   const MoveLimit& limit = {});
 
 //! The median of |F| over the moving vertices (kSpeedDefined, not boundary); 0 if none.
 //! Δt times this, divided by e_min, is what the step-small stopping rule reads (SPEC §4).
 //! Allocates one buffer per call (a global reduction, not a per-block stage).
 double median_speed(const TriMesh& mesh, const VertexFields& fields);
+
+//! The \p quantile (in (0, 1]; 1 = the maximum) of |F| over the moving vertices, the value at
+//! rank ceil(quantile·n) − 1 of the sorted speeds; 0 if none move. Allocates one buffer.
+double speed_quantile(const TriMesh& mesh, const VertexFields& fields, double quantile);
 
 }  // namespace mvflow

@@ -1,5 +1,6 @@
 #include "stages/stopping.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -32,11 +33,37 @@ StoppingCriterion::StoppingCriterion(StoppingOptions options) : options_(options
   history_.reserve(static_cast<std::size_t>(options_.max_iterations));
 }
 
-double StoppingCriterion::change_percent(std::size_t lag) const {
-  const double current = history_.back();
-  const double previous = history_[history_.size() - 1 - lag];
+namespace {
+
+double relative_change_percent(double current, double previous) {
   if (previous == 0.0) return current == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
   return std::abs(100.0 - 100.0 * current / previous);
+}
+
+}  // namespace
+
+double StoppingCriterion::change_percent(std::size_t lag) const {
+  return relative_change_percent(history_.back(), history_[history_.size() - 1 - lag]);
+}
+
+bool StoppingCriterion::converged() const {
+  const auto w = static_cast<std::size_t>(options_.lookback);
+  if (options_.test == ConvergenceTest::NoImprovement) {
+    const auto split = history_.end() - static_cast<std::ptrdiff_t>(w);  // ≥ 1 value before it
+    const double recent = *std::min_element(split, history_.end());
+    const double earlier = *std::min_element(history_.begin(), split);
+    if (!(recent == recent) || !(earlier == earlier)) return false;  // NaN never converges
+    if (earlier == 0.0) return true;  // nothing left to improve
+    return 100.0 - 100.0 * recent / earlier < options_.epsilon_percent;
+  }
+  for (std::size_t lag = 1; lag <= w; ++lag)
+    if (!(change_percent(lag) < options_.epsilon_percent)) return false;
+  return true;
+}
+
+void StoppingCriterion::restart() {
+  before_restart_ += history_.size();
+  history_.clear();
 }
 
 std::vector<double> StoppingCriterion::last_changes_percent() const {
@@ -49,15 +76,11 @@ std::vector<double> StoppingCriterion::last_changes_percent() const {
 
 StopReason StoppingCriterion::add_iteration(double sum_g, double median_move_over_emin) {
   history_.push_back(sum_g);
-  const std::size_t i = history_.size();
-  if (i >= static_cast<std::size_t>(options_.min_iterations)) {
-    bool converged = true;  // min_iterations > lookback, so every G_{i−l} exists
-    for (std::size_t lag = 1; lag <= static_cast<std::size_t>(options_.lookback) && converged; ++lag)
-      converged = change_percent(lag) < options_.epsilon_percent;  // NaN (a NaN Σg) never converges
-    if (converged) return StopReason::Converged;
+  if (history_.size() >= static_cast<std::size_t>(options_.min_iterations)) {
+    if (converged()) return StopReason::Converged;
     if (median_move_over_emin < options_.median_move_tolerance) return StopReason::StepSmall;
   }
-  if (i >= static_cast<std::size_t>(options_.max_iterations)) return StopReason::MaxIterations;
+  if (iterations() >= static_cast<std::size_t>(options_.max_iterations)) return StopReason::MaxIterations;
   return StopReason::Continue;
 }
 

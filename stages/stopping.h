@@ -16,12 +16,26 @@ enum class StopReason {
 //! "continue", "converged", "step-small" or "max-iterations" (for reports).
 const char* to_string(StopReason reason);
 
+//! How "Σg no longer changes" is tested.
+enum class ConvergenceTest {
+  //! Thesis 5.3.3: |100 − 100·G_i/G_{i−l}| < ε for every l = 1..lookback. Never fires while Σg
+  //! alternates between two values, as it does once the fastest vertices step across the
+  //! minimum of g and back.
+  EachLookback,
+  //! No improvement: the lowest G of the last `lookback` iterations is not ε % below the lowest
+  //! G before them, 100 − 100·min(G_{i−w+1..i})/min(G_1..G_{i−w}) < ε with w = lookback (early
+  //! stopping with patience w). An alternation around a level no longer lowers the minimum, so
+  //! it stops.
+  NoImprovement,
+};
+
 struct StoppingOptions {
-  //! ε in percent: converged when |100 − 100·G_i/G_{i−l}| < ε for l = 1..lookback; > 0.
-  //! 0.3 (the thesis's experiments).
+  //! ε in percent (see ConvergenceTest); > 0. 0.3 (the thesis's experiments).
   double epsilon_percent = 0.3;
-  //! No stop (Converged or StepSmall) before this many completed iterations; ≥ lookback + 1,
-  //! so that every G_{i−l} exists. 10 (thesis 5.3.3).
+  //! NoImprovement; EachLookback in the thesis preset. README, "Defaults and differences".
+  ConvergenceTest test = ConvergenceTest::NoImprovement;
+  //! No stop (Converged or StepSmall) before this many completed iterations (since the start
+  //! or the last restart); ≥ lookback + 1, so that every G compared exists. 10 (thesis 5.3.3).
   int min_iterations = 10;
   //! Stop after this many completed iterations at the latest; ≥ min_iterations. 100 (thesis).
   int max_iterations = 100;
@@ -38,13 +52,13 @@ struct StoppingOptions {
 //!
 //! Iterations are counted from 1: the i-th call of add_iteration reports iteration i, and
 //! i is the number of completed iterations. With G_i the Σg passed at iteration i:
-//!  - Converged at i ≥ min_iterations when, for every l = 1..lookback,
-//!    |100 − 100·G_i/G_{i−l}| < ε (a G_{i−l} = 0 counts as a change of 0 if G_i = 0 too and as
-//!    an infinite change otherwise);
+//!  - Converged at i ≥ min_iterations when options.test says Σg has stopped changing (a
+//!    previous value 0 counts as a change of 0 if the current one is 0 too and as an infinite
+//!    change otherwise);
 //!  - StepSmall at i ≥ min_iterations when median_move_over_emin < τ. Like the ε rule it waits
 //!    for min_iterations: the first iterations run on a freshly remeshed surface whose median
 //!    move says little about convergence, and a few extra iterations cost little;
-//!  - MaxIterations at i ≥ max_iterations.
+//!  - MaxIterations at i ≥ max_iterations (counted over restarts).
 //! When several fire at once the first in this list is reported. After a stop, further calls
 //! keep evaluating the same rules on the longer history.
 class StoppingCriterion {
@@ -58,8 +72,12 @@ class StoppingCriterion {
   //!                              shortest edge; pass 0 when nothing moved (NaN never fires).
   StopReason add_iteration(double sum_g, double median_move_over_emin);
 
-  //! Completed iterations so far (the i of the last add_iteration).
-  std::size_t iterations() const { return history_.size(); }
+  //! Starts the Converged and StepSmall rules afresh (after a change of the mesh's resolution Σg
+  //! sums over other vertices); the iteration count for MaxIterations goes on.
+  void restart();
+
+  //! Completed iterations so far, restarts included.
+  std::size_t iterations() const { return before_restart_ + history_.size(); }
   //! |100 − 100·G_i/G_{i−l}| of the last iteration for l = 1..lookback (fewer if the history
   //! is shorter), for reports.
   std::vector<double> last_changes_percent() const;
@@ -68,8 +86,11 @@ class StoppingCriterion {
  private:
   double change_percent(std::size_t lag) const;
 
+  bool converged() const;
+
   StoppingOptions options_;
-  std::vector<double> history_;  // G_1 .. G_i
+  std::vector<double> history_;  // G since the start or the last restart
+  std::size_t before_restart_ = 0;
 };
 
 }  // namespace mvflow

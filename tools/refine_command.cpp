@@ -27,6 +27,9 @@ struct RefineArguments {
   bool ascii = false;
   bool no_remeshing = false;
   bool no_adaptive = false;
+  bool local_step = false;
+  std::string refine_when;        // "iteration" or "converged"; empty: the preset's
+  std::string convergence;        // "each-lookback" or "no-improvement"; empty: the preset's
   int threads = 0;
   RefineOptions options;          // values given on the command line override the preset
 };
@@ -37,6 +40,9 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"block_size", o.block_size},
           {"velocity", o.speed.velocity},
           {"cfl", o.cfl},
+          {"speed_quantile", o.speed_quantile},
+          {"reference_edge_quantile", o.reference_edge_quantile},
+          {"local_step", o.local_step},
           {"patch", 2 * o.photo.photo.half_patch + 1},
           {"savitzky_golay_k", o.photo.savitzky_golay.k},
           {"savitzky_golay_order", o.photo.savitzky_golay.order},
@@ -52,6 +58,10 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"median_move_tolerance", o.stopping.median_move_tolerance},
           {"global_remeshing", o.global_remeshing},
           {"adaptive_refinement", o.adaptive_refinement},
+          {"adaptive_curvature_factor", o.adaptive.curvature_factor},
+          {"adaptive_min_edge_pixels", o.adaptive.min_edge_pixels},
+          {"refine_when", o.refinement_schedule == RefinementSchedule::EveryIteration ? "iteration" : "converged"},
+          {"convergence_test", o.stopping.test == ConvergenceTest::EachLookback ? "each-lookback" : "no-improvement"},
           {"excluded_views", o.excluded_views}};
 }
 
@@ -65,6 +75,10 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--block-size", options.block_size, given.block_size);
   set("--velocity", options.speed.velocity, given.speed.velocity);
   set("--cfl", options.cfl, given.cfl);
+  set("--speed-quantile", options.speed_quantile, given.speed_quantile);
+  set("--reference-edge", options.reference_edge_quantile, given.reference_edge_quantile);
+  set("--refine-min-pixels", options.adaptive.min_edge_pixels, given.adaptive.min_edge_pixels);
+  set("--refine-curvature", options.adaptive.curvature_factor, given.adaptive.curvature_factor);
   set("--max-view-angle", options.visibility.max_angle_degrees, given.visibility.max_angle_degrees);
   set("--smoothing", options.smoothing.lambda_dt, given.smoothing.lambda_dt);
   set("--smoothing-steps", options.smoothing.steps, given.smoothing.steps);
@@ -82,6 +96,13 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   }
   if (args.no_remeshing) options.global_remeshing = false;
   if (args.no_adaptive) options.adaptive_refinement = false;
+  if (args.local_step) options.local_step = true;
+  if (!args.refine_when.empty())
+    options.refinement_schedule =
+        args.refine_when == "iteration" ? RefinementSchedule::EveryIteration : RefinementSchedule::AtConvergence;
+  if (!args.convergence.empty())
+    options.stopping.test =
+        args.convergence == "each-lookback" ? ConvergenceTest::EachLookback : ConvergenceTest::NoImprovement;
   options.excluded_views = given.excluded_views;
   options.engine = args.engine == "sequential" ? EngineKind::Sequential : EngineKind::Graph;
   return options;
@@ -152,6 +173,9 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--block-size", o.block_size, "Vertices per block (graph node)")->check(CLI::PositiveNumber)->capture_default_str();
   c->add_option("--velocity", o.speed.velocity, "Balloon velocity v of the speed g(v+H)")->capture_default_str();
   c->add_option("--cfl", o.cfl, "CFL factor of the time step")->capture_default_str();
+  c->add_option("--speed-quantile", o.speed_quantile,
+                "Quantile of |F| that sets the time step (1 = max, the thesis); faster vertices move the CFL distance")
+      ->capture_default_str();
   c->add_option("--patch", o.photo.photo.half_patch, "Patch half size (2 = 5×5)")->check(CLI::Range(1, 7))->capture_default_str();
   c->add_option("--sg-k", o.photo.savitzky_golay.k, "Savitzky–Golay k (window k+1 samples per axis)")->capture_default_str();
   c->add_option("--sg-order", o.photo.savitzky_golay.order, "Savitzky–Golay polynomial order")->capture_default_str();
@@ -168,6 +192,24 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--step-tolerance", o.stopping.median_move_tolerance, "Stop when the median move is below this × e_min")
       ->capture_default_str();
   c->add_flag("--no-remeshing", args->no_remeshing, "Skip the global split/collapse before the flow");
+  c->add_option("--reference-edge", o.reference_edge_quantile,
+                "e_S (split/collapse, adaptive refinement) is this quantile of the initial edge lengths (0 = shortest)")
+      ->capture_default_str();
+  c->add_option("--refine-min-pixels", o.adaptive.min_edge_pixels,
+                "Adaptive refinement leaves faces with an edge shorter than this many pixels at the object")
+      ->capture_default_str();
+  c->add_option("--refine-curvature", o.adaptive.curvature_factor,
+                "Adaptive refinement marks vertices whose curvature-normal length exceeds this × e_S")
+      ->capture_default_str();
+  c->add_option("--refine-when", args->refine_when,
+                "Adaptive refinement before every iteration (the thesis) or when the flow has converged at the "
+                "current resolution (default: converged; thesis preset: iteration)")
+      ->check(CLI::IsMember({"iteration", "converged"}));
+  c->add_option("--convergence", args->convergence,
+                "Σg convergence test: each-lookback (the thesis: every one of the last 5 changes below ε) or "
+                "no-improvement (the best Σg of the last 5 iterations is not ε below the best before; default)")
+      ->check(CLI::IsMember({"each-lookback", "no-improvement"}));
+  c->add_flag("--local-step", args->local_step, "Local CFL bound (Δt from the mean edge, each vertex within its own edges)");
   c->add_flag("--no-adaptive", args->no_adaptive, "Skip adaptive refinement between iterations");
   c->add_option("--exclude-views", o.excluded_views, "0-based views not to use (held out)")->delimiter(',');
   c->add_flag("--ascii", args->ascii, "Write PLY as ASCII");
