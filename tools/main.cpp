@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   add_batch_command(app, runner);
   add_slice_command(app, runner);
   add_render_command(app, runner);
+  add_heldout_command(app, runner);
   add_synth_command(app, runner);
   add_subdivide_command(app, runner);
 
