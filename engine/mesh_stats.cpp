@@ -4,8 +4,6 @@
 #include <limits>
 #include <vector>
 
-#include "engine/error.h"
-
 namespace mvflow {
 
 EdgeLengths edge_lengths(const TriMesh& mesh) {
@@ -21,17 +19,6 @@ EdgeLengths edge_lengths(const TriMesh& mesh) {
   }
   lengths.mean = sum / static_cast<double>(mesh.n_edges());
   return lengths;
-}
-
-double edge_length_quantile(const TriMesh& mesh, double quantile) {
-  MVFLOW_CHECK(quantile >= 0.0 && quantile <= 1.0, "edge_length_quantile: quantile must be in [0, 1]");
-  std::vector<double> lengths;
-  lengths.reserve(mesh.n_edges());
-  for (auto e : mesh.edges()) lengths.push_back(mesh.calc_edge_length(e));
-  if (lengths.empty()) return 0.0;
-  const auto nth = lengths.begin() + static_cast<std::ptrdiff_t>(quantile * static_cast<double>(lengths.size() - 1));
-  std::nth_element(lengths.begin(), nth, lengths.end());
-  return *nth;
 }
 
 MeshStats compute_mesh_stats(const Mesh& mesh) {

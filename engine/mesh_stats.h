@@ -37,8 +37,5 @@ struct EdgeLengths {
   double mean = 0.0;
 };
 EdgeLengths edge_lengths(const TriMesh& mesh);
-//! The \p quantile (in [0, 1]; 0 = the shortest) of the mesh's edge lengths: the value at rank
-//! floor(quantile·(n−1)) of the sorted lengths. 0 for a mesh without edges.
-double edge_length_quantile(const TriMesh& mesh, double quantile);
 
 }  // namespace mvflow

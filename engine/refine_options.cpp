@@ -13,7 +13,6 @@ void RefineOptions::check() const {
   require(speed.check(), "velocity");
   require(cfl > 0 && cfl <= 10, "cfl (0, 10]");
   require(speed_quantile > 0 && speed_quantile <= 1, "speed quantile (0, 1]");
-  require(reference_edge_quantile >= 0 && reference_edge_quantile <= 1, "reference edge quantile [0, 1]");
   require(smoothing.check(), "smoothing (lambda*dt in (0,1), steps >= 0)");
   require(regularization.check(), "regularization (strength in (0,1], steps >= 0)");
   require(stopping.check(), "stopping (epsilon, iterations, lookback, tolerance)");
@@ -32,7 +31,7 @@ RefineOptions thesis_preset() {
   options.curvature.area = CurvatureArea::Barycentric;
   options.stopping.epsilon_percent = 0.3;
   options.speed_quantile = 1.0;
-  options.reference_edge_quantile = 0.0;
+  options.local_step = false;
   options.adaptive.min_edge_pixels = 0.0;
   options.refinement_schedule = RefinementSchedule::EveryIteration;
   options.stopping.test = ConvergenceTest::EachLookback;

@@ -42,18 +42,15 @@ struct RefineOptions {
   //! q, the quantile of |F| over the moving vertices that sets Δt; in (0, 1]. 1 = max|F|, the
   //! thesis's CFL rule. Below 1, vertices faster than |F|_q move the CFL distance
   //! cfl·e_min/(2√3) along F, no more, so no vertex ever moves farther than under the thesis's rule.
-  double speed_quantile = 1.0;
+  double speed_quantile = 0.9;
   //! Local CFL: Δt uses the mean edge instead of the shortest, and each vertex moves at most
   //! cfl/(2√3) of its own shortest edge, so one short edge slows only its own vertices. false:
   //! the thesis's global rule (every vertex moves at most cfl·e_min/(2√3)).
-  bool local_step = false;
+  bool local_step = true;
   SmoothingOptions smoothing;
   RegularizationOptions regularization;
   StoppingOptions stopping;
   bool global_remeshing = true;        //!< split/collapse once before the flow (SPEC §5)
-  //! e_S, the reference edge of split/collapse and adaptive refinement, is this quantile of the
-  //! initial mesh's edge lengths; in [0, 1]. 0 = the shortest edge (thesis B.7).
-  double reference_edge_quantile = 0.0;
   RemeshingOptions remeshing;
   bool adaptive_refinement = true;     //!< quadrisect high-curvature regions between iterations
   AdaptiveRefinementOptions adaptive;

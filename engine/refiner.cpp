@@ -194,7 +194,7 @@ class Refinement {
   // Thesis §5.3.4, before the flow: split/collapse against e_S, one smoothing and one
   // regularization pass over the whole mesh.
   void prepare() {
-    reference_edge_ = edge_length_quantile(mesh_, options_.reference_edge_quantile);
+    reference_edge_ = edge_lengths(mesh_).shortest;
     BoundingBox box;
     for (auto v : mesh_.vertices()) box.extend(to_eigen(mesh_.point(v)));
     pixel_size_ = finest_pixel_size(views_, box.centre());

@@ -53,15 +53,30 @@ RefineOptions few_iterations(int iterations) {
 
 std::vector<Eigen::Vector3d> positions(const RefineResult& result) { return positions_of(result.mesh.topology); }
 
-TEST(Refiner, SameBitsForThreadsBlockSizesAndEngines) {
+// Both time-step rules and both refinement schedules: the default (quantile step, local CFL
+// bound, refinement when the flow has converged, which the short minimum lets happen within the
+// run) and the thesis's (max|F|, global bound, refinement before every iteration).
+std::vector<RefineOptions> determinism_cases() {
+  RefineOptions by_default = few_iterations(12);
+  by_default.stopping.min_iterations = 6;
+  by_default.stopping.epsilon_percent = 50.0;  // "converged" early, so it refines within the run
+  RefineOptions thesis_rules = few_iterations(6);
+  thesis_rules.speed_quantile = 1.0;
+  thesis_rules.local_step = false;
+  thesis_rules.refinement_schedule = RefinementSchedule::EveryIteration;
+  return {by_default, thesis_rules};
+}
+
+void expect_same_bits(const RefineOptions& options) {
   const SmallScene& s = small_scene();
-  const RefineOptions options = few_iterations(6);
   RefineControl two, one;
   two.threads = 2;
   one.threads = 1;
   const RefineResult reference = refine_mesh(s.scene, s.initial, options, two);
   ASSERT_NE(reference.summary.status, RefineStatus::Failed) << reference.summary.message;
-  ASSERT_EQ(reference.summary.iterations.size(), 6u);
+  std::size_t refined = 0;
+  for (const IterationReport& r : reference.summary.iterations) refined += r.refined_faces;
+  EXPECT_GT(refined, 0u) << "the case must exercise adaptive refinement";
 
   const RefineResult single = refine_mesh(s.scene, s.initial, options, one);
   RefineOptions other_blocks = options;
@@ -82,6 +97,10 @@ TEST(Refiner, SameBitsForThreadsBlockSizesAndEngines) {
   }
 }
 
+TEST(Refiner, SameBitsForThreadsBlockSizesAndEngines) {
+  for (const RefineOptions& options : determinism_cases()) expect_same_bits(options);
+}
+
 TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {
   const SmallScene& s = small_scene();
   RefineOptions options = few_iterations(40);
@@ -98,11 +117,10 @@ TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {
               after.symmetric_mean(), before.accuracy(), after.accuracy(), result.summary.initial_sum_g_per_vertex,
               result.summary.final_sum_g_per_vertex, result.summary.initial_vertices, result.summary.final_vertices,
               result.summary.self_intersections);
-  // Measured (this scene, 40 iterations, 300 → 4128 vertices): mean 0.0294 → 0.0149, accuracy
-  // 0.053 → 0.035. The engine issue's ≥ 50 % target is for full-size scenes; this pins the
-  // direction of the flow.
-  EXPECT_LT(after.symmetric_mean(), 0.9 * before.symmetric_mean());
-  EXPECT_LT(after.accuracy(), before.accuracy());
+  // Measured (this scene, 40 iterations, 300 → 3692 vertices): mean 0.0294 → 0.0049, accuracy
+  // 0.0526 → 0.0096. tests/quality_test.cpp checks the full pipeline on the README's scenes.
+  EXPECT_LT(after.symmetric_mean(), 0.5 * before.symmetric_mean());
+  EXPECT_LT(after.accuracy(), 0.5 * before.accuracy());
   EXPECT_LT(result.summary.final_sum_g_per_vertex, result.summary.initial_sum_g_per_vertex);
   EXPECT_EQ(result.summary.self_intersections, 0u);
   EXPECT_EQ(result.mesh.quality.size(), result.mesh.n_vertices());

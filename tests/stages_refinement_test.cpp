@@ -224,6 +224,20 @@ TEST_F(BumpedSphere, MinimumEdgeBlocksRefinement) {
   EXPECT_EQ(triangles_of(blocked), triangles_of(bump.mesh));
   EXPECT_EQ(positions_of(blocked), positions_of(bump.mesh));
 
+  // The same floor given in pixels: min_edge_pixels × pixel_size blocks exactly like the
+  // relative floor of the same length.
+  TriMesh blocked_by_pixels = bump.mesh;
+  const double pixel_size = largest * 1.0001 * diagonal / 5.0;
+  const RefinementResult none_by_pixels =
+      refine_adaptively(blocked_by_pixels, fields, bump.reference_edge, {.min_edge_pixels = 5.0}, pixel_size);
+  EXPECT_EQ(none_by_pixels.red_faces + none_by_pixels.new_vertices, 0u);
+  TriMesh pixels_between = bump.mesh;
+  const RefinementResult some_by_pixels = refine_adaptively(
+      pixels_between, fields, bump.reference_edge, {.min_edge_pixels = 5.0}, 0.5 * (smallest + largest) * diagonal / 5.0);
+  EXPECT_EQ(some_by_pixels.red_faces - some_by_pixels.promoted_faces,
+            marked_faces(bump.mesh, fields, threshold, 0.5 * (smallest + largest) * diagonal).size());
+  EXPECT_THROW(refine_adaptively(pixels_between, fields, bump.reference_edge, {}, -1.0), Error);
+
   TriMesh partly = bump.mesh;  // between: only the faces whose edges are all long enough
   const double between = 0.5 * (smallest + largest);
   const RefinementResult some =

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <vector>
 
@@ -157,6 +159,56 @@ TEST(Move, AppliesEulerStepToDefinedInteriorVerticesOnly) {
   EXPECT_THROW(move_vertices(mesh, test::all_vertices(mesh), fields, -1.0), Error);
   // The median over moving vertices: interior ids 6,7,8,11,13,16,17,18 → speeds id+1.
   EXPECT_EQ(median_speed(mesh, fields), 0.5 * (12.0 + 14.0));
+}
+
+TEST(Move, LimitsEachVertexToADistanceOrAFractionOfItsOwnShortestEdge) {
+  // make_grid(1.0, 4): a 5×5 grid of spacing 0.25 (every vertex's shortest edge), interior
+  // vertices 6..8, 11..13, 16..18; speeds grow with the id.
+  TriMesh mesh = test::to_trimesh(make_grid(1.0, 4));
+  VertexFields fields;
+  fields.resize(mesh.n_vertices(), 0);
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+    fields.speed[v] = Eigen::Vector3d(0.0, 0.0, 1.0 + static_cast<double>(v));
+    fields.defined[v] = kSpeedDefined;
+  }
+  compute_local_edges(mesh, test::all_vertices(mesh), fields);
+  for (auto v : mesh.vertices()) {  // against an independent walk over the edges
+    double shortest = std::numeric_limits<double>::infinity();
+    for (auto e : mesh.edges())
+      if (mesh.from_vertex_handle(mesh.halfedge_handle(e, 0)) == v || mesh.to_vertex_handle(mesh.halfedge_handle(e, 0)) == v)
+        shortest = std::min(shortest, mesh.calc_edge_length(e));
+    EXPECT_DOUBLE_EQ(fields.local_edge[static_cast<std::size_t>(v.idx())], shortest);
+  }
+  const TriMesh before = mesh;
+  TriMesh by_distance = mesh;
+  const double dt = 0.01;  // dt·|F| = 0.07 .. 0.19 for the interior ids
+  move_vertices(mesh, test::all_vertices(mesh), fields, dt, MoveLimit{.local_edge_fraction = 0.4});  // 0.1
+  move_vertices(by_distance, test::all_vertices(by_distance), fields, dt, MoveLimit{.distance = 0.12});
+  for (auto v : mesh.vertices()) {
+    if (mesh.is_boundary(v)) continue;
+    const double free_move = dt * (1.0 + v.idx());
+    EXPECT_DOUBLE_EQ(mesh.point(v)[2] - before.point(v)[2], std::min(free_move, 0.4 * 0.25)) << v.idx();
+    EXPECT_DOUBLE_EQ(by_distance.point(v)[2] - before.point(v)[2], std::min(free_move, 0.12)) << v.idx();
+  }
+  EXPECT_THROW(move_vertices(mesh, test::all_vertices(mesh), fields, dt, MoveLimit{.distance = 0.0}), Error);
+}
+
+TEST(Speed, QuantileOfTheMovingVertices) {
+  TriMesh mesh = test::to_trimesh(make_grid(1.0, 4));
+  VertexFields fields;
+  fields.resize(mesh.n_vertices(), 0);
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+    fields.speed[v] = Eigen::Vector3d(1.0 + static_cast<double>(v), 0.0, 0.0);
+    fields.defined[v] = kSpeedDefined;
+  }
+  // Interior speeds (id + 1), sorted: 7 8 9 12 13 14 17 18 19 (n = 9; boundary vertices never
+  // move).
+  EXPECT_EQ(speed_quantile(mesh, fields, 1.0), 19.0);
+  EXPECT_EQ(speed_quantile(mesh, fields, 0.9), 19.0);   // rank ceil(8.1) − 1 = 8
+  EXPECT_EQ(speed_quantile(mesh, fields, 0.75), 17.0);  // rank ceil(6.75) − 1 = 6
+  EXPECT_EQ(speed_quantile(mesh, fields, 0.5), 13.0);   // rank ceil(4.5) − 1 = 4
+  EXPECT_EQ(speed_quantile(mesh, fields, 0.01), 7.0);
+  EXPECT_THROW(speed_quantile(mesh, fields, 0.0), Error);
 }
 
 }  // namespace

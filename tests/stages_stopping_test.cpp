@@ -13,9 +13,12 @@ namespace {
 
 constexpr double large_move = 1.0;  // far above τ: only the Σg rule or the budget can fire
 
+// The thesis's test: every one of the last five changes below ε.
+StoppingOptions each_lookback() { return StoppingOptions{.test = ConvergenceTest::EachLookback}; }
+
 // Feeds \p g and returns the iteration (1-based) at which the criterion stopped, 0 if never.
 std::pair<std::size_t, StopReason> run(const std::vector<double>& g, double move = large_move,
-                                       StoppingOptions options = {}) {
+                                       StoppingOptions options = each_lookback()) {
   StoppingCriterion criterion(options);
   for (std::size_t i = 0; i < g.size(); ++i) {
     const StopReason reason = criterion.add_iteration(g[i], move);
@@ -25,9 +28,10 @@ std::pair<std::size_t, StopReason> run(const std::vector<double>& g, double move
   return {0, StopReason::Continue};
 }
 
-TEST(StoppingOptions, DefaultsFollowTheThesis) {
+TEST(StoppingOptions, DefaultsFollowTheThesisButForTheConvergenceTest) {
   const StoppingOptions o;
   EXPECT_TRUE(o.check());
+  EXPECT_EQ(o.test, ConvergenceTest::NoImprovement);
   EXPECT_EQ(o.epsilon_percent, 0.3);
   EXPECT_EQ(o.min_iterations, 10);
   EXPECT_EQ(o.max_iterations, 100);
@@ -74,7 +78,7 @@ TEST(Stopping, AtMaxIterationsAtTheLatest) {
   std::vector<double> g;
   for (int i = 1; i <= 150; ++i) g.push_back(i % 2 ? 100.0 : 110.0);
   EXPECT_EQ(run(g), std::make_pair(std::size_t{100}, StopReason::MaxIterations));
-  StoppingOptions short_run;
+  StoppingOptions short_run = each_lookback();
   short_run.max_iterations = 12;
   EXPECT_EQ(run(g, large_move, short_run), std::make_pair(std::size_t{12}, StopReason::MaxIterations));
   // A zero G_{i−l} with a positive G_i is an infinite change, not convergence.
@@ -91,11 +95,45 @@ TEST(Stopping, WhenTheMedianMoveIsSmallFromMinIterationsOn) {
   EXPECT_EQ(run(g, 0.0025).second, StopReason::Continue);  // above τ = 0.002: runs out of g
   EXPECT_EQ(run(g, std::nan("")).second, StopReason::Continue);
   // A small move at iteration 13 only.
-  StoppingCriterion criterion{StoppingOptions{}};
+  StoppingCriterion criterion{each_lookback()};
   for (int i = 1; i <= 12; ++i) EXPECT_EQ(criterion.add_iteration(g[i - 1], 0.5), StopReason::Continue);
   EXPECT_EQ(criterion.add_iteration(g[12], 0.0019), StopReason::StepSmall);
   // Converged wins when both fire.
   EXPECT_EQ(run(std::vector<double>(30, 5.0), 0.0), std::make_pair(std::size_t{10}, StopReason::Converged));
+}
+
+TEST(Stopping, NoImprovementStopsAnAlternationThatEachLookbackNeverStops) {
+  // Σg falls 2 % per iteration to iteration 20, then alternates ±5 % around its last level, as
+  // it does once the fastest vertices step across the minimum of g and back.
+  std::vector<double> g;
+  for (int i = 1; i <= 20; ++i) g.push_back(100.0 * std::pow(0.98, i));
+  for (int i = 21; i <= 120; ++i) g.push_back(g[19] * (i % 2 ? 1.05 : 0.95));
+  EXPECT_EQ(run(g), std::make_pair(std::size_t{100}, StopReason::MaxIterations));
+  // The lowest value, 0.95·G_20, comes at iteration 22 and never again: at 27 the last five
+  // (23..27) have not improved on it.
+  EXPECT_EQ(run(g, large_move, StoppingOptions{}), std::make_pair(std::size_t{27}, StopReason::Converged));
+}
+
+TEST(Stopping, NoImprovementWaitsForEpsilonAndRestartsWithTheResolution) {
+  // 1 % lower every iteration: always an improvement beyond 0.3 % over five iterations.
+  std::vector<double> g;
+  for (int i = 1; i <= 60; ++i) g.push_back(1000.0 * std::pow(0.99, i));
+  EXPECT_EQ(run(g, large_move, StoppingOptions{}), std::make_pair(std::size_t{0}, StopReason::Continue));
+  // 0.05 % per iteration: the best of the last five is 0.25 % below the best before: converged
+  // as soon as the history is long enough (min_iterations = 10).
+  g.clear();
+  for (int i = 1; i <= 40; ++i) g.push_back(1000.0 * std::pow(0.9995, i));
+  EXPECT_EQ(run(g, large_move, StoppingOptions{}), std::make_pair(std::size_t{10}, StopReason::Converged));
+  // After restart() the rules wait min_iterations again, but the budget counts on.
+  StoppingCriterion criterion{StoppingOptions{.max_iterations = 25}};
+  for (int i = 1; i <= 10; ++i) criterion.add_iteration(5.0, large_move);
+  criterion.restart();
+  EXPECT_EQ(criterion.iterations(), 10u);
+  for (int i = 11; i <= 19; ++i) EXPECT_EQ(criterion.add_iteration(5.0, large_move), StopReason::Continue) << i;
+  EXPECT_EQ(criterion.add_iteration(5.0, large_move), StopReason::Converged);  // 10 since the restart
+  criterion.restart();
+  for (int i = 21; i <= 24; ++i) EXPECT_EQ(criterion.add_iteration(5.0, large_move), StopReason::Continue) << i;
+  EXPECT_EQ(criterion.add_iteration(5.0, large_move), StopReason::MaxIterations);
 }
 
 TEST(Stopping, ReportsTheLastChanges) {

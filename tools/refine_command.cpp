@@ -27,7 +27,7 @@ struct RefineArguments {
   bool ascii = false;
   bool no_remeshing = false;
   bool no_adaptive = false;
-  bool local_step = false;
+  std::string step;               // "local" or "global"; empty: the preset's
   std::string refine_when;        // "iteration" or "converged"; empty: the preset's
   std::string convergence;        // "each-lookback" or "no-improvement"; empty: the preset's
   int threads = 0;
@@ -41,7 +41,6 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"velocity", o.speed.velocity},
           {"cfl", o.cfl},
           {"speed_quantile", o.speed_quantile},
-          {"reference_edge_quantile", o.reference_edge_quantile},
           {"local_step", o.local_step},
           {"patch", 2 * o.photo.photo.half_patch + 1},
           {"savitzky_golay_k", o.photo.savitzky_golay.k},
@@ -76,7 +75,6 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--velocity", options.speed.velocity, given.speed.velocity);
   set("--cfl", options.cfl, given.cfl);
   set("--speed-quantile", options.speed_quantile, given.speed_quantile);
-  set("--reference-edge", options.reference_edge_quantile, given.reference_edge_quantile);
   set("--refine-min-pixels", options.adaptive.min_edge_pixels, given.adaptive.min_edge_pixels);
   set("--refine-curvature", options.adaptive.curvature_factor, given.adaptive.curvature_factor);
   set("--max-view-angle", options.visibility.max_angle_degrees, given.visibility.max_angle_degrees);
@@ -96,7 +94,7 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   }
   if (args.no_remeshing) options.global_remeshing = false;
   if (args.no_adaptive) options.adaptive_refinement = false;
-  if (args.local_step) options.local_step = true;
+  if (!args.step.empty()) options.local_step = args.step == "local";
   if (!args.refine_when.empty())
     options.refinement_schedule =
         args.refine_when == "iteration" ? RefinementSchedule::EveryIteration : RefinementSchedule::AtConvergence;
@@ -192,9 +190,6 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--step-tolerance", o.stopping.median_move_tolerance, "Stop when the median move is below this × e_min")
       ->capture_default_str();
   c->add_flag("--no-remeshing", args->no_remeshing, "Skip the global split/collapse before the flow");
-  c->add_option("--reference-edge", o.reference_edge_quantile,
-                "e_S (split/collapse, adaptive refinement) is this quantile of the initial edge lengths (0 = shortest)")
-      ->capture_default_str();
   c->add_option("--refine-min-pixels", o.adaptive.min_edge_pixels,
                 "Adaptive refinement leaves faces with an edge shorter than this many pixels at the object")
       ->capture_default_str();
@@ -209,7 +204,10 @@ void add_refine_command(CLI::App& app, Runner& runner) {
                 "Σg convergence test: each-lookback (the thesis: every one of the last 5 changes below ε) or "
                 "no-improvement (the best Σg of the last 5 iterations is not ε below the best before; default)")
       ->check(CLI::IsMember({"each-lookback", "no-improvement"}));
-  c->add_flag("--local-step", args->local_step, "Local CFL bound (Δt from the mean edge, each vertex within its own edges)");
+  c->add_option("--step", args->step,
+                "CFL bound: local (Δt from the mean edge, each vertex moves at most cfl/(2√3) of its own shortest "
+                "edge; default) or global (the thesis: every vertex within cfl/(2√3) of the mesh's shortest edge)")
+      ->check(CLI::IsMember({"local", "global"}));
   c->add_flag("--no-adaptive", args->no_adaptive, "Skip adaptive refinement between iterations");
   c->add_option("--exclude-views", o.excluded_views, "0-based views not to use (held out)")->delimiter(',');
   c->add_flag("--ascii", args->ascii, "Write PLY as ASCII");
