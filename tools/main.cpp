@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   add_render_command(app, runner);
   add_synth_command(app, runner);
   add_subdivide_command(app, runner);
+  add_hull_command(app, runner);
 
   try {
     app.parse(argc, argv);
