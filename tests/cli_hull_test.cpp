@@ -125,5 +125,24 @@ TEST_F(CliHull, BadInputNamesTheFileAndLeavesTheOutputAlone) {
   EXPECT_EQ(test::read_text(out), "keep");
 }
 
+// `mvflow synth --init hull`: the visual hull of the truth's exact silhouettes (ray cast, so the
+// textured background does not matter). Measured: 404 vertices, symmetric mean distance 0.0088
+// to the truth (radius 1) with 8 views of 160x120.
+TEST(CliSynth, InitHullIsAClosedMeshCloseToTheTruth) {
+  test::ScratchFolder folder;
+  const std::string scene = (folder / "scene").string();
+  CommandResult r = run_mvflow("synth --views 8 --width 160 --height 120 --level 3 --init hull --init-vertices 400 -o " + scene);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_mvflow("info " + scene + " --mesh " + scene + "/init.ply");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "1 component(s), total genus 0, Euler characteristic 2, 0 boundary edge(s)")) << r.output;
+  r = run_mvflow("eval " + scene + "/init.ply " + scene + "/truth.ply --samples 20000");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::smatch mean;
+  ASSERT_TRUE(std::regex_search(r.output, mean, std::regex("mean  symmetric +([0-9.e+-]+)"))) << r.output;
+  EXPECT_LT(std::stod(mean[1]), 0.02) << r.output;
+  EXPECT_EQ(run_mvflow("synth --init hull:2 -o " + scene).exit_code, 2);
+}
+
 }  // namespace
 }  // namespace mvflow
