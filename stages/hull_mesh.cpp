@@ -59,6 +59,7 @@ HullMeshResult make_hull_mesh(const std::vector<Camera>& cameras, const std::vec
   IndexedMesh surface = extract_iso_surface(grid, options.extraction);
   result.extracted_vertices = surface.positions.size();
   surface = largest_component(surface, &result.extracted_components);
+  result.kept_vertices = surface.positions.size();
   result.seconds_extraction = seconds_since(start);
 
   // Straight from the fine surface: the first round's collapses do what a decimation would, in

@@ -39,8 +39,8 @@ struct HullMeshOptions {
   int remeshing_iterations = 12;
   //! After the remeshing, the surface is cut along every loop of three edges that holds an edge
   //! shorter than this fraction of the target length (stages/neck_cutting.h): a neck or handle
-  //! thinner than the mesh resolution, where no remeshing can lengthen the edges (0..0.8).
-  //! 3 more rounds of remeshing follow each batch of cuts.
+  //! thinner than the mesh resolution, where no remeshing can lengthen the edges (0..0.8;
+  //! 0: never cut). 3 more rounds of remeshing follow each batch of cuts.
   double neck_edge = 0.5;
   //! \throw InputError naming the field when a value is out of range.
   void check() const;
@@ -53,6 +53,7 @@ struct HullMeshResult {
   std::size_t inside_samples = 0;       //!< grid samples kept by the carving
   std::size_t extracted_vertices = 0;   //!< of the iso-surface, all components
   std::size_t extracted_components = 0;
+  std::size_t kept_vertices = 0;        //!< of the iso-surface's largest component
   std::size_t neck_cuts = 0;            //!< thin necks and handles cut away
   double target_edge = 0.0;             //!< the remeshing's final target edge length
   double seconds_carving = 0.0, seconds_extraction = 0.0, seconds_remeshing = 0.0;

@@ -117,8 +117,13 @@ int run_hull(const HullArguments& args, spdlog::logger& log) {
   fmt::print(", dilated by {} px, holes up to {} % of the image filled\n", args.silhouette.dilate, 100 * args.fill_holes);
   fmt::print("grid        {} x {} x {} samples, spacing {:.4g}, {} inside ({:.2f} s)\n", hull.grid_size[0],
              hull.grid_size[1], hull.grid_size[2], hull.grid_spacing, hull.inside_samples, hull.seconds_carving);
-  fmt::print("surface     {} vertices in {} component(s), the largest kept ({:.2f} s)\n", hull.extracted_vertices,
-             hull.extracted_components, hull.seconds_extraction);
+  const double kept = static_cast<double>(hull.kept_vertices) / static_cast<double>(hull.extracted_vertices);
+  fmt::print("surface     {} vertices in {} component(s), the largest ({:.1f} % of the vertices) kept ({:.2f} s)\n",
+             hull.extracted_vertices, hull.extracted_components, 100.0 * kept, hull.seconds_extraction);
+  if (kept < 0.9)
+    log.warn("the carved hull fell apart: the largest piece holds only {:.1f} % of the surface (check the silhouettes "
+             "and the bounding box)",
+             100.0 * kept);
   fmt::print("mesh        {} vertices, {} faces, {} components, genus {}, {}, {}, {} thin neck(s) cut ({:.2f} s)\n",
              stats.vertices, stats.faces, stats.components, stats.genus, stats.is_closed() ? "closed" : "OPEN",
              stats.is_manifold() ? "manifold" : "NON-MANIFOLD", hull.neck_cuts, hull.seconds_remeshing);
@@ -136,8 +141,9 @@ void add_hull_command(CLI::App& app, Runner& runner) {
   CLI::App* c = app.add_subcommand(
       "hull",
       "Initial mesh from silhouettes: the visual hull carved on a grid inside the bounding box, its surface "
-      "extracted (marching tetrahedra on a signed distance to the silhouette outlines), the largest piece, "
-      "decimated and remeshed isotropically to --vertices vertices; closed, manifold, outward normals");
+      "extracted (marching tetrahedra on a signed distance to the silhouette outlines), the largest piece "
+      "remeshed isotropically to about --vertices vertices with edges of nearly one length, necks thinner than "
+      "the mesh cut; closed, manifold, outward normals");
   c->add_option("scene", args->scene, "Scene folder, or a camera file inside one")->required();
   c->add_option("-o,--output", args->output, "Mesh to write; format from the extension, written atomically")
       ->required();
@@ -146,7 +152,7 @@ void add_hull_command(CLI::App& app, Runner& runner) {
       "Folder of mask images, one per view, matched by file-name stem (non-zero = object); default: threshold the "
       "photographs");
   c->add_option("--save-masks", args->save_masks,
-                "Also write the silhouettes used (after dilation) as PNGs into this folder, named like the views' "
+                "Also write the silhouettes used (after dilation and hole filling) as PNGs into this folder, named like the views' "
                 "images, so they can be checked, edited and passed to --masks");
   c->add_option("--threshold", args->silhouette.threshold,
                 "A pixel is object when its largest channel exceeds this (on [0,1]); 0.19 suits the Middlebury "
@@ -179,6 +185,11 @@ void add_hull_command(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   c->add_option("--vertices", args->options.vertices, "Target vertex count of the mesh")
       ->check(CLI::Range(20, 10000000))
+      ->capture_default_str();
+  c->add_option("--neck-edge", args->options.neck_edge,
+                "Cut the mesh along loops of three edges around necks and handles thinner than the mesh, where an "
+                "edge stays shorter than this fraction of the target length (0 = never cut)")
+      ->check(CLI::Range(0.0, 0.8))
       ->capture_default_str();
   c->add_option("--remesh-iterations", args->options.remeshing_iterations, "Rounds of isotropic remeshing")
       ->check(CLI::Range(2, 1000))
