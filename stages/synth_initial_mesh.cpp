@@ -161,6 +161,8 @@ IndexedMesh decimate(const IndexedMesh& mesh, int vertices) {
 
 IndexedMesh make_initial_mesh(const IndexedMesh& truth, const InitialMeshOptions& options) {
   options.check();
+  if (options.kind == InitialMeshKind::Hull)
+    throw InputError("initial mesh: the visual hull needs the views; make_synth_scene builds it");
   require_closed_manifold(truth);
   IndexedMesh mesh;
   mesh.positions = truth.positions;

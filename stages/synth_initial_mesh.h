@@ -10,7 +10,8 @@ namespace mvflow {
 
 enum class InitialMeshKind {
   Offset,  //!< truth smoothed (volume kept), pushed out along the normals, decimated
-  Noise    //!< truth decimated, each vertex moved along its normal by a random amount
+  Noise,   //!< truth decimated, each vertex moved along its normal by a random amount
+  Hull     //!< the visual hull of the truth's silhouettes in the rendered views (make_synth_scene)
 };
 
 struct InitialMeshOptions {
@@ -26,7 +27,8 @@ struct InitialMeshOptions {
 };
 
 //! The initial mesh for \p truth (closed, manifold). Texture coordinates are dropped.
-//! \throw InputError when \p truth is not a closed manifold mesh.
+//! \throw InputError when \p truth is not a closed manifold mesh, or for the kind Hull, which
+//!        needs the views (make_synth_scene builds it).
 IndexedMesh make_initial_mesh(const IndexedMesh& truth, const InitialMeshOptions& options);
 
 //! Laplacian diffusion (normalized cotangent weights clamped at 0, λ = 0.5) of \p mesh over

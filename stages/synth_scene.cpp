@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "engine/error.h"
+#include "stages/hull_mesh.h"
 
 namespace mvflow {
 
@@ -11,6 +15,33 @@ namespace {
 
 // Independent streams for the independent random choices, all from one user seed.
 enum SeedStream : std::uint64_t { kSurfaceTexture = 1, kBackgroundTexture = 2, kPixelNoise = 3, kInitNoise = 4 };
+
+// The exact silhouette of the truth in a view: a pixel is object when the ray through its centre
+// meets the truth, whatever the background and the texture. Parallel over rows.
+Mask truth_silhouette(const SurfaceQuery& truth, const Camera& camera) {
+  Mask mask(camera.width(), camera.height());
+  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height()), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < camera.width(); ++x) {
+        const Ray ray = camera.ray(x, y);
+        mask.inside[static_cast<std::size_t>(y) * camera.width() + x] = truth.intersect(ray.origin, ray.direction).has_value();
+      }
+  });
+  return mask;
+}
+
+// The visual hull of the truth's exact silhouettes, remeshed to the initial mesh's vertex count.
+IndexedMesh hull_initial_mesh(const SynthScene& scene, const SurfaceQuery& truth, int vertices) {
+  std::vector<Camera> cameras;
+  std::vector<Mask> silhouettes;
+  for (const View& view : scene.views) {
+    cameras.push_back(view.camera);
+    silhouettes.push_back(truth_silhouette(truth, view.camera));
+  }
+  HullMeshOptions options;
+  options.vertices = vertices;
+  return make_hull_mesh(cameras, silhouettes, scene.bounding_box, options).mesh;
+}
 
 }  // namespace
 
@@ -85,15 +116,17 @@ SynthScene make_synth_scene(const IndexedMesh& truth, std::shared_ptr<const Imag
   scene.bounding_box.max = box.max.array() + margin;
 
   // The initial mesh first: it rejects an open or non-manifold truth before seconds of rendering.
+  // A hull needs the views, so it comes last.
   InitialMeshOptions init = options.init;
   init.seed = mix_seed(options.seed, kInitNoise);
-  scene.initial = make_initial_mesh(truth, init);
+  if (init.kind != InitialMeshKind::Hull) scene.initial = make_initial_mesh(truth, init);
 
   scene.views = make_rig(options.rig, scene.centre, scene.radius);
   const SynthRenderer renderer =
       make_synth_renderer(truth, std::move(uv_texture), options, scene.centre, scene.radius, &scene.uv_albedo);
   scene.images.reserve(scene.views.size());
   for (std::size_t i = 0; i < scene.views.size(); ++i) scene.images.push_back(renderer.render(scene.views[i].camera, i));
+  if (init.kind == InitialMeshKind::Hull) scene.initial = hull_initial_mesh(scene, renderer.surface(), init.vertices);
   return scene;
 }
 

@@ -40,6 +40,9 @@ void add_render_command(CLI::App& app, Runner& runner);
 //! `mvflow heldout SCENE MESH --views i,j [--json FILE] [-o DIR] [--threshold T|--masks DIR] ...`
 void add_heldout_command(CLI::App& app, Runner& runner);
 
+//! `mvflow hull SCENE -o OUT [--masks DIR | --threshold T] [--dilate PX] [--bbox ...] [--vertices N]`
+void add_hull_command(CLI::App& app, Runner& runner);
+
 //! `mvflow subdivide MESH --scheme loop|modloop|butterfly [--iterations N] [--sharp-angle DEG] [--faces FILE] -o OUT`
 void add_subdivide_command(CLI::App& app, Runner& runner);
 

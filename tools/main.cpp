@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   add_heldout_command(app, runner);
   add_synth_command(app, runner);
   add_subdivide_command(app, runner);
+  add_hull_command(app, runner);
 
   try {
     app.parse(argc, argv);

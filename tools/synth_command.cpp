@@ -166,9 +166,12 @@ struct InitSpec {
 std::string parse_init(const std::string& text, InitSpec& spec) {
   const auto colon = text.find(':');
   const std::string kind = text.substr(0, colon);
-  if (kind == "hull") return "--init hull is not implemented yet (expected offset:D or noise:D)";
+  if (text == "hull") {
+    spec.kind = InitialMeshKind::Hull;
+    return {};
+  }
   if ((kind != "offset" && kind != "noise") || colon == std::string::npos)
-    return "expected offset:D or noise:D (D relative to the bounding-box diagonal)";
+    return "expected offset:D, noise:D (D relative to the bounding-box diagonal) or hull";
   spec.kind = kind == "offset" ? InitialMeshKind::Offset : InitialMeshKind::Noise;
   try {
     std::size_t used = 0;
@@ -425,13 +428,15 @@ void add_synth_command(CLI::App& app, Runner& runner) {
   bind_option(c, a, "--height", &Settings::height, "Image height in pixels")->check(CLI::Range(8, 8192));
   bind_option(c, a, "--fov", &Settings::fov, "Horizontal field of view in degrees (unless --focal)")->check(CLI::Range(1.0, 170.0));
   bind_option(c, a, "--focal", &Settings::focal, "Focal length in pixels (0 = from --fov)")->check(CLI::Range(0.0, 1e6));
-  bind_option(c, a, "--init", &Settings::init, "Initial mesh: offset:D (smoothed, pushed out by D x diagonal) or noise:D")
+  bind_option(c, a, "--init", &Settings::init,
+              "Initial mesh: offset:D (smoothed, pushed out by D x diagonal), noise:D, or hull (the visual hull of "
+              "the truth's exact silhouettes in the rendered views, as mvflow hull makes it)")
       ->check(CLI::Validator(
           [](std::string& text) {
             InitSpec spec;
             return parse_init(text, spec);
           },
-          "offset:D|noise:D"));
+          "offset:D|noise:D|hull"));
   bind_option(c, a, "--init-vertices", &Settings::init_vertices, "Initial mesh vertex count (decimation target)")
       ->check(CLI::Range(20, 10000000));
   bind_option(c, a, "--init-smoothing", &Settings::init_smoothing, "offset: smoothing length, x bounding-box diagonal")

@@ -1,0 +1,26 @@
+#pragma once
+// Silhouette mask files: one image per view in a folder, matched to the view's photograph by
+// file-name stem (dinoSR0001.png ↔ masks/dinoSR0001.png, .pgm, .jpg, ...). Any image OpenCV
+// decodes; a pixel whose largest channel is non-zero is object (stages/silhouette.h turns the
+// image into a mask).
+
+#include <filesystem>
+#include <string>
+
+#include "engine/camera.h"
+#include "engine/image.h"
+
+namespace mvflow::io {
+
+//! The mask file of \p view (the \p index-th view of its scene) in \p folder: the one file whose
+//! stem is the stem of view.image_name and whose extension is an image format (png, pgm, ppm,
+//! pbm, bmp, jpg, jpeg, tif, tiff; any case).
+//! \throw IoError when \p folder is not a folder; InputError naming the expected file when
+//!        there is none, or listing the candidates when there are several.
+std::filesystem::path find_mask_file(const std::filesystem::path& folder, const View& view, std::size_t index);
+
+//! Reads a mask image and checks that it has the size of \p view's camera.
+//! \throw as io::read_image; InputError naming the file, both sizes and the view otherwise.
+Image read_mask_image(const std::filesystem::path& file, const View& view, std::size_t index);
+
+}  // namespace mvflow::io
