@@ -42,6 +42,8 @@ void IterationData::reset_topology() {
   new_positions.assign(mesh.n_vertices(), Eigen::Vector3d::Zero());
   block_seconds.assign(blocks.size(), {});
   refit_needed = false;
+  step_scale = 1.0;  // Σg/vertex of another mesh says nothing about the steps on this one
+  previous_g_per_vertex = 0.0;
 }
 
 void IterationData::refit() {
@@ -87,8 +89,9 @@ void IterationData::cfl() {
   const double reference_speed =
       options.speed_quantile < 1.0 ? speed_quantile(mesh, fields, options.speed_quantile) : total.max_speed;
   const double step_edge = options.local_step ? mean_edge : shortest_edge;
-  time_step = cfl_time_step(step_edge, reference_speed, options.cfl);
-  const double cfl_fraction = cfl_time_step(1.0, 1.0, options.cfl);  // Δt·|F| / edge at the CFL bound
+  adapt_step_scale();
+  time_step = step_scale * cfl_time_step(step_edge, reference_speed, options.cfl);
+  const double cfl_fraction = step_scale * cfl_time_step(1.0, 1.0, options.cfl);  // Δt·|F| / edge at the bound
   move_limit = options.local_step ? MoveLimit{.local_edge_fraction = cfl_fraction}
                                   : MoveLimit{.distance = cfl_fraction * shortest_edge};
   moving = 0;
@@ -96,10 +99,20 @@ void IterationData::cfl() {
   median_move = std::min(time_step * median_speed(mesh, fields), cfl_fraction * step_edge) / shortest_edge;
 }
 
+void IterationData::adapt_step_scale() {
+  const double g_per_vertex = total.defined_g ? total.sum_g / static_cast<double>(total.defined_g) : 0.0;
+  if (options.step_control && previous_g_per_vertex > 0.0) {
+    // The last step raised Σg/vertex: it overshot the minimum of g, so halve the steps; after
+    // a step that lowered it, let them grow back toward the CFL bound.
+    step_scale = g_per_vertex > previous_g_per_vertex ? 0.5 * step_scale : std::min(1.0, 1.25 * step_scale);
+  }
+  previous_g_per_vertex = g_per_vertex;
+}
+
 void IterationData::move(std::size_t block) {
   if (cancelled()) return;
   StageTimer timer(block_seconds[block][static_cast<int>(Stage::Move)]);
-  move_vertices(mesh, blocks[block], fields, time_step, move_limit);
+  move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside);
 }
 
 void IterationData::smooth(std::size_t block) {
@@ -117,7 +130,7 @@ void IterationData::regularize(std::size_t block) {
 
 void IterationData::commit(std::size_t block) {
   if (cancelled()) return;
-  commit_positions(mesh, blocks[block], new_positions);
+  commit_positions(mesh, blocks[block], new_positions, inside);
 }
 
 void run_iteration_sequential(IterationData& data) {

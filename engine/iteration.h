@@ -19,6 +19,7 @@
 #include "engine/vertex_fields.h"
 #include "stages/photo_gradient.h"
 #include "stages/photo_views.h"
+#include "stages/silhouette_constraint.h"
 #include "stages/speed.h"
 
 namespace mvflow {
@@ -34,6 +35,7 @@ struct IterationData {
   const RefineOptions& options;
   const std::atomic<bool>* cancel;
   PhotoGradientStage photo;
+  const SilhouetteConstraint* inside = nullptr;  //!< keeps the surface in the visual hull when set
 
   std::unique_ptr<SurfaceQuery> surface;  //!< rebuilt when the topology changes, refitted otherwise
   VertexFields fields;
@@ -51,6 +53,8 @@ struct IterationData {
   BlockPartial total;
   double time_step = 0.0;
   MoveLimit move_limit;      //!< the CFL bound on one vertex's move
+  double step_scale = 1.0;   //!< the fraction of the CFL step taken (step control), reset with the topology
+  double previous_g_per_vertex = 0.0;  //!< Σg/vertex of the previous iteration on this topology
   double median_move = 0.0;  //!< in units of e_min
   std::size_t moving = 0;
   double serial_seconds[kStageCount] = {};
@@ -65,6 +69,7 @@ struct IterationData {
   void visibility(std::size_t block);  //!< visible views
   void photo_speed(std::size_t block); //!< g, ∇g (3k+1 samples), F, and the block's partial
   void cfl();                          //!< serial: combine partials in block order, Δt, median move
+  void adapt_step_scale();             //!< part of cfl(): the step control
   void move(std::size_t block);        //!< P ← P + Δt·F
   void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
   void regularize(std::size_t block);  //!< normals at the current positions, then regularization

@@ -19,6 +19,7 @@ void RefineOptions::check() const {
   require(remeshing.check(), "remeshing factors");
   require(adaptive.check(), "adaptive refinement thresholds");
   require(block_size >= 1, "block size >= 1");
+  require(silhouettes.check(), "silhouettes (threshold in [0, 1), dilation >= 0)");
   require(photo.photo.half_patch == visibility.half_patch, "the visibility patch must equal the photo patch");
   for (int view : excluded_views) require(view >= 0, "excluded views are 0-based indices");
 }
@@ -32,6 +33,7 @@ RefineOptions thesis_preset() {
   options.stopping.epsilon_percent = 0.3;
   options.speed_quantile = 1.0;
   options.local_step = false;
+  options.step_control = false;
   options.adaptive.min_edge_pixels = 0.0;
   options.refinement_schedule = RefinementSchedule::EveryIteration;
   options.stopping.test = ConvergenceTest::EachLookback;

@@ -11,6 +11,7 @@
 #include "stages/photo_gradient.h"
 #include "stages/regularization.h"
 #include "stages/remeshing.h"
+#include "stages/silhouette.h"
 #include "stages/smoothing.h"
 #include "stages/speed.h"
 #include "stages/stopping.h"
@@ -47,6 +48,10 @@ struct RefineOptions {
   //! cfl/(2√3) of its own shortest edge, so one short edge slows only its own vertices. false:
   //! the thesis's global rule (every vertex moves at most cfl·e_min/(2√3)).
   bool local_step = true;
+  //! Step control: when an iteration finds Σg/vertex higher than the one before (on the same
+  //! mesh), the last step overshot, so the steps are halved; after a decrease they grow back by
+  //! 1.25× up to the CFL step. false: always the CFL step (the thesis).
+  bool step_control = false;
   SmoothingOptions smoothing;
   RegularizationOptions regularization;
   StoppingOptions stopping;
@@ -61,6 +66,13 @@ struct RefineOptions {
   std::size_t block_size = 128;
   EngineKind engine = EngineKind::Graph;
   std::vector<int> excluded_views;     //!< 0-based view indices the refinement must not use
+  //! Keep the surface inside the visual hull of the used views' silhouettes (thresholded from
+  //! their images; SilhouetteConstraint). Off by default and in the thesis: it needs photographs
+  //! whose background separates from the object.
+  bool keep_inside_silhouettes = false;
+  //! How the silhouettes are thresholded; 0.19 (Middlebury) with a 3-pixel dilation so that
+  //! calibration error does not cut into the object.
+  SilhouetteOptions silhouettes{.threshold = 0.19, .dilate = 3};
 
   //! \throw InputError naming the first option out of range.
   void check() const;

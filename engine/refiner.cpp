@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 
 #include "engine/bounding_box.h"
@@ -20,6 +21,7 @@
 #include "stages/regularization.h"
 #include "stages/remeshing.h"
 #include "stages/self_intersections.h"
+#include "stages/silhouette_constraint.h"
 #include "stages/smoothing.h"
 #include "stages/visibility.h"
 
@@ -103,7 +105,12 @@ class Refinement {
  public:
   Refinement(const Scene& scene, const Mesh& initial, const RefineOptions& options, const RefineControl& control)
       : options_(options), control_(control), views_(usable_views(scene, options.excluded_views)),
-        mesh_(initial.topology), data_(mesh_, views_, options_, control.cancel) {}
+        mesh_(initial.topology), data_(mesh_, views_, options_, control.cancel) {
+    if (options.keep_inside_silhouettes) {
+      inside_.emplace(views_, threshold_silhouettes(views_, options.silhouettes));
+      data_.inside = &*inside_;
+    }
+  }
 
   RefineResult run() {
     const auto start = Clock::now();
@@ -271,6 +278,7 @@ class Refinement {
   double reference_edge_ = 0.0;
   double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
+  std::optional<SilhouetteConstraint> inside_;
 };
 
 }  // namespace

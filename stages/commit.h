@@ -8,6 +8,7 @@
 
 #include "engine/mesh.h"
 #include "engine/vertex_fields.h"
+#include "stages/silhouette_constraint.h"
 
 namespace mvflow {
 
@@ -17,6 +18,8 @@ namespace mvflow {
 //! \param vertices      Range of vertex ids, within [0, #V).
 //! \param new_positions #V positions (entries outside \p vertices are not read).
 //! \throw Error if the range or the buffer size does not match the mesh.
-void commit_positions(TriMesh& mesh, IndexRange vertices, const std::vector<Eigen::Vector3d>& new_positions);
+//! \param inside        When given, no vertex leaves the visual hull (SilhouetteConstraint::limit_move).
+void commit_positions(TriMesh& mesh, IndexRange vertices, const std::vector<Eigen::Vector3d>& new_positions,
+                      const SilhouetteConstraint* inside = nullptr);
 
 }  // namespace mvflow

@@ -80,7 +80,8 @@ void compute_local_edges(const TriMesh& mesh, IndexRange vertices, VertexFields&
   }
 }
 
-void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt, const MoveLimit& limit) {
+void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt, const MoveLimit& limit,
+                   const SilhouetteConstraint* inside) {
   MVFLOW_CHECK(dt >= 0.0 && std::isfinite(dt), "move_vertices: dt must be finite and >= 0");
   MVFLOW_CHECK(limit.distance > 0.0 && limit.local_edge_fraction >= 0.0, "move_vertices: invalid move limit");
   detail::check_range(vertices, mesh.n_vertices(), "move_vertices");
@@ -93,7 +94,8 @@ void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& field
     if (limit.local_edge_fraction > 0.0) longest = std::min(longest, limit.local_edge_fraction * fields.local_edge[id]);
     const double length = step.norm();
     if (length > longest) step *= longest / length;
-    mesh.set_point(v, mesh.point(v) + to_openmesh(step));
+    const Eigen::Vector3d from = to_eigen(mesh.point(v));
+    mesh.set_point(v, to_openmesh(inside ? inside->limit_move(from, from + step) : from + step));
   }
 }
 

@@ -8,6 +8,7 @@
 
 #include "engine/mesh.h"
 #include "engine/vertex_fields.h"
+#include "stages/silhouette_constraint.h"
 
 namespace mvflow {
 
@@ -79,8 +80,9 @@ struct MoveLimit {
 //! \throw Error if dt or the sizes are invalid.
 //! \param limit    How far one vertex may move; a faster vertex moves that far along F. No limit
 //!                 (the default) moves every vertex by dt·F, as the thesis does.
+//! \param inside   When given, no vertex leaves the visual hull (SilhouetteConstraint::limit_move).
 void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt,
-                   const MoveLimit& limit = {});
+                   const MoveLimit& limit = {}, const SilhouetteConstraint* inside = nullptr);
 
 //! The median of |F| over the moving vertices (kSpeedDefined, not boundary); 0 if none.
 //! Δt times this, divided by e_min, is what the step-small stopping rule reads (SPEC §4).

@@ -58,6 +58,24 @@ TEST_F(CliHull, WritesAClosedManifoldMeshOfAboutTheRequestedSize) {
   EXPECT_TRUE(contains(info.output, "0 non-manifold vertex(es)")) << info.output;
 }
 
+TEST_F(CliHull, ExcludedViewsCarveNothingSoTheHullOnlyGrows) {
+  // Fewer views carve less: the hull of 12 views contains the hull of 16, so its volume is larger.
+  // With the ring rig, the views left out are the only ones seeing some flanks head on.
+  test::ScratchFolder folder;
+  auto volume_of = [&](const std::string& extra) {
+    const CommandResult r = run_mvflow("hull " + scene() + " --threshold 0.005 --vertices 800 -o " +
+                                       (folder / "hull.ply").string() + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::smatch volume;
+    EXPECT_TRUE(std::regex_search(r.output, volume, std::regex("volume +([0-9.eE+-]+)"))) << r.output;
+    return volume.size() > 1 ? std::stod(volume[1]) : 0.0;
+  };
+  const double all = volume_of("");
+  const double without_four = volume_of(" --exclude-views 0,4,8,12");
+  std::printf("[measured] hull volume %.5f with every view, %.5f without views 0,4,8,12\n", all, without_four);
+  EXPECT_GT(without_four, all);
+}
+
 TEST_F(CliHull, MaskFilesGiveTheSameMeshAsTheThresholdTheyCameFrom) {
   test::ScratchFolder folder;
   const std::string masks = (folder / "masks").string();
@@ -115,6 +133,9 @@ TEST_F(CliHull, BadInputNamesTheFileAndLeavesTheOutputAlone) {
   EXPECT_TRUE(contains(r.output, "--bbox")) << r.output;
   r = run_mvflow("hull " + scene() + " -o " + (folder / "out.xyz").string());
   EXPECT_EQ(r.exit_code, 1) << r.output;
+  r = run_mvflow("hull " + scene() + " --threshold 0.005 --exclude-views 3,16" + tail);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "excluded view 16 does not exist (the scene has 16 views, 0..15)")) << r.output;
 
   // Usage errors.
   EXPECT_EQ(run_mvflow("hull " + scene() + " --masks " + masks.string() + " --threshold 0.1" + tail).exit_code, 2);

@@ -3,7 +3,10 @@
 
 #include <random>
 
+#include "engine/camera.h"
+#include "engine/error.h"
 #include "stages/silhouette.h"
+#include "stages/silhouette_constraint.h"
 
 namespace mvflow {
 namespace {
@@ -54,6 +57,51 @@ TEST(Silhouette, ThresholdUsesTheLargestChannel) {
   EXPECT_TRUE(mask.at(1, 0));
   EXPECT_FALSE(mask.at(2, 0));
   EXPECT_EQ(mask_from_image(image).count(), 3u);
+}
+
+// One camera 5 units in front of the origin looking down +z (focal 100 px, 101×101 pixels), whose
+// silhouette is the disc of radius 20 pixels around the image centre: on the plane z = 0 the
+// pixel u = 50 + 20·x, so the hull's cross-section there is the disc |(x, y)| ≤ 1.
+struct DiscScene {
+  Camera camera{(Eigen::Matrix3d() << 100, 0, 50, 0, 100, 50, 0, 0, 1).finished(), Eigen::Matrix3d::Identity(),
+                Eigen::Vector3d(0, 0, 5), 101, 101};
+  Image image{101, 101};
+  std::vector<Camera> cameras{camera};
+  std::vector<PhotoView> views = make_photo_views(cameras, {&image});
+  Mask disc() const {
+    Mask mask(101, 101);
+    for (int y = 0; y < 101; ++y)
+      for (int x = 0; x < 101; ++x) mask.inside[y * 101 + x] = (x - 50) * (x - 50) + (y - 50) * (y - 50) <= 400;
+    return mask;
+  }
+};
+
+TEST(SilhouetteConstraint, AdmitsWhatProjectsIntoTheSilhouetteOrOutsideTheImage) {
+  const DiscScene s;
+  const SilhouetteConstraint inside(s.views, {s.disc()});
+  EXPECT_TRUE(inside.admits({0.5, 0.0, 0.0}));
+  EXPECT_TRUE(inside.admits({0.0, -0.99, 0.0}));
+  EXPECT_FALSE(inside.admits({1.1, 0.0, 0.0}));   // u = 72: outside the disc
+  EXPECT_FALSE(inside.admits({0.8, 0.8, 0.0}));   // radius 1.13
+  EXPECT_TRUE(inside.admits({10.0, 0.0, 0.0}));   // u = 250: the view does not see it
+  EXPECT_TRUE(inside.admits({1.5, 0.0, -10.0}));  // behind the camera
+}
+
+TEST(SilhouetteConstraint, StopsMovesOutOfTheHullButNotMovesOfPointsAlreadyOutside) {
+  const DiscScene s;
+  const SilhouetteConstraint inside(s.views, {s.disc()});
+  const Eigen::Vector3d centre(0, 0, 0);
+  EXPECT_EQ(inside.limit_move(centre, {0.9, 0, 0}), Eigen::Vector3d(0.9, 0, 0));  // stays inside
+  EXPECT_EQ(inside.limit_move(centre, {1.6, 0, 0}), Eigen::Vector3d(0.8, 0, 0));  // halved once
+  // From 0.9 toward 2.4: the halvings reach 1.65, 1.275, 1.0875 (outside) and 0.99375 (u = 69.875,
+  // the disc's last pixel).
+  const Eigen::Vector3d from(0.9, 0, 0), to(2.4, 0, 0);
+  EXPECT_EQ(inside.limit_move(from, to), from + 0.0625 * (to - from));
+  // From 0.99 every halving (1.695 .. 1.034, u ≥ 70.7) is outside: the vertex stays.
+  EXPECT_EQ(inside.limit_move({0.99, 0, 0}, to), Eigen::Vector3d(0.99, 0, 0));
+  EXPECT_EQ(inside.limit_move({2, 0, 0}, {3, 0, 0}), Eigen::Vector3d(3, 0, 0));  // already outside: free
+  EXPECT_THROW(SilhouetteConstraint(s.views, {}), Error);
+  EXPECT_THROW(SilhouetteConstraint(s.views, {Mask(100, 101)}), Error);
 }
 
 }  // namespace

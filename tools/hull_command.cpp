@@ -3,6 +3,7 @@
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <cmath>
@@ -36,7 +37,24 @@ struct HullArguments {
   HullMeshOptions options;
   int threads = 0;
   bool ascii = false;
+  std::vector<int> excluded_views;  // held out: neither their silhouettes nor their images are read
 };
+
+// The views the hull is carved from: every view but the excluded ones, in scene order.
+std::vector<std::size_t> used_views(const HullArguments& args, const Scene& scene) {
+  for (int view : args.excluded_views)
+    if (view < 0 || static_cast<std::size_t>(view) >= scene.size())
+      throw InputError(scene.folder, 0, "excluded view " + std::to_string(view) + " does not exist (the scene has " +
+                                            std::to_string(scene.size()) + " views, 0.." +
+                                            std::to_string(static_cast<int>(scene.size()) - 1) + ")");
+  std::vector<std::size_t> used;
+  for (std::size_t i = 0; i < scene.size(); ++i)
+    if (std::find(args.excluded_views.begin(), args.excluded_views.end(), static_cast<int>(i)) ==
+        args.excluded_views.end())
+      used.push_back(i);
+  if (used.size() < 2) throw InputError(scene.folder, 0, "fewer than 2 views are left to carve with");
+  return used;
+}
 
 BoundingBox bounding_box(const HullArguments& args, const Scene& scene, spdlog::logger& log) {
   if (args.bbox.empty()) {
@@ -56,10 +74,11 @@ BoundingBox bounding_box(const HullArguments& args, const Scene& scene, spdlog::
 
 //! One silhouette per view, from the mask files or by thresholding the photographs, dilated,
 //! with its small holes filled.
-std::vector<Mask> silhouettes(const HullArguments& args, const Scene& scene, spdlog::logger& log) {
+std::vector<Mask> silhouettes(const HullArguments& args, const Scene& scene, const std::vector<std::size_t>& used,
+                              spdlog::logger& log) {
   std::vector<Mask> masks;
-  masks.reserve(scene.size());
-  for (std::size_t i = 0; i < scene.size(); ++i) {
+  masks.reserve(used.size());
+  for (const std::size_t i : used) {
     const View& view = scene.views[i];
     if (!args.masks.empty()) {
       const auto file = io::find_mask_file(args.masks, view, i);
@@ -79,14 +98,15 @@ std::vector<Mask> silhouettes(const HullArguments& args, const Scene& scene, spd
 }
 
 //! Writes \p masks as black-and-white PNGs named after the views' images, readable by --masks.
-void save_masks(const std::filesystem::path& folder, const Scene& scene, const std::vector<Mask>& masks) {
+void save_masks(const std::filesystem::path& folder, const Scene& scene, const std::vector<std::size_t>& used,
+                const std::vector<Mask>& masks) {
   std::filesystem::create_directories(folder);
-  for (std::size_t i = 0; i < masks.size(); ++i) {
-    Image image(masks[i].width, masks[i].height);
+  for (std::size_t k = 0; k < masks.size(); ++k) {
+    Image image(masks[k].width, masks[k].height);
     float* rgb = image.data();
-    for (std::size_t p = 0; p < masks[i].inside.size(); ++p)
-      if (masks[i].inside[p]) rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = 1.0f;
-    io::write_png(folder / (std::filesystem::path(scene.views[i].image_name).stem().string() + ".png"), image);
+    for (std::size_t p = 0; p < masks[k].inside.size(); ++p)
+      if (masks[k].inside[p]) rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = 1.0f;
+    io::write_png(folder / (std::filesystem::path(scene.views[used[k]].image_name).stem().string() + ".png"), image);
   }
 }
 
@@ -95,10 +115,11 @@ int run_hull(const HullArguments& args, spdlog::logger& log) {
   const auto start = std::chrono::steady_clock::now();
   const Scene scene = io::load_scene(args.scene);
   const BoundingBox box = bounding_box(args, scene, log);
-  const std::vector<Mask> masks = silhouettes(args, scene, log);
-  if (!args.save_masks.empty()) save_masks(args.save_masks, scene, masks);
+  const std::vector<std::size_t> used = used_views(args, scene);
+  const std::vector<Mask> masks = silhouettes(args, scene, used, log);
+  if (!args.save_masks.empty()) save_masks(args.save_masks, scene, used, masks);
   std::vector<Camera> cameras;
-  for (const View& view : scene.views) cameras.push_back(view.camera);
+  for (const std::size_t i : used) cameras.push_back(scene.views[i].camera);
 
   HullMeshResult hull;
   tbb::task_arena arena(args.threads > 0 ? args.threads : tbb::task_arena::automatic);
@@ -197,6 +218,9 @@ void add_hull_command(CLI::App& app, Runner& runner) {
   c->add_option("--threads", args->threads, "Worker threads (0 = all cores; the mesh does not depend on it)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  c->add_option("--exclude-views", args->excluded_views,
+                "0-based views not to carve with (held out: their photographs are never read)")
+      ->delimiter(',');
   c->add_flag("--ascii", args->ascii, "Write PLY/STL as ASCII instead of binary");
   c->callback([args, &runner] { runner = [args](spdlog::logger& log) { return run_hull(*args, log); }; });
 }

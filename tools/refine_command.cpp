@@ -28,6 +28,7 @@ struct RefineArguments {
   bool no_remeshing = false;
   bool no_adaptive = false;
   std::string step;               // "local" or "global"; empty: the preset's
+  std::string step_control;       // "on" or "off"; empty: the preset's
   std::string refine_when;        // "iteration" or "converged"; empty: the preset's
   std::string convergence;        // "each-lookback" or "no-improvement"; empty: the preset's
   int threads = 0;
@@ -42,6 +43,7 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"cfl", o.cfl},
           {"speed_quantile", o.speed_quantile},
           {"local_step", o.local_step},
+          {"step_control", o.step_control},
           {"patch", 2 * o.photo.photo.half_patch + 1},
           {"savitzky_golay_k", o.photo.savitzky_golay.k},
           {"savitzky_golay_order", o.photo.savitzky_golay.order},
@@ -61,7 +63,10 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"adaptive_min_edge_pixels", o.adaptive.min_edge_pixels},
           {"refine_when", o.refinement_schedule == RefinementSchedule::EveryIteration ? "iteration" : "converged"},
           {"convergence_test", o.stopping.test == ConvergenceTest::EachLookback ? "each-lookback" : "no-improvement"},
-          {"excluded_views", o.excluded_views}};
+          {"excluded_views", o.excluded_views},
+          {"keep_inside_silhouettes", o.keep_inside_silhouettes},
+          {"silhouette_threshold", o.silhouettes.threshold},
+          {"silhouette_dilate", o.silhouettes.dilate}};
 }
 
 // Starts from the preset and applies every option the user gave.
@@ -75,6 +80,9 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--velocity", options.speed.velocity, given.speed.velocity);
   set("--cfl", options.cfl, given.cfl);
   set("--speed-quantile", options.speed_quantile, given.speed_quantile);
+  set("--silhouette-threshold", options.silhouettes.threshold, given.silhouettes.threshold);
+  set("--silhouette-dilate", options.silhouettes.dilate, given.silhouettes.dilate);
+  if (command.count("--keep-inside-silhouettes") > 0) options.keep_inside_silhouettes = true;
   set("--refine-min-pixels", options.adaptive.min_edge_pixels, given.adaptive.min_edge_pixels);
   set("--refine-curvature", options.adaptive.curvature_factor, given.adaptive.curvature_factor);
   set("--max-view-angle", options.visibility.max_angle_degrees, given.visibility.max_angle_degrees);
@@ -95,6 +103,7 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   if (args.no_remeshing) options.global_remeshing = false;
   if (args.no_adaptive) options.adaptive_refinement = false;
   if (!args.step.empty()) options.local_step = args.step == "local";
+  if (!args.step_control.empty()) options.step_control = args.step_control == "on";
   if (!args.refine_when.empty())
     options.refinement_schedule =
         args.refine_when == "iteration" ? RefinementSchedule::EveryIteration : RefinementSchedule::AtConvergence;
@@ -208,6 +217,16 @@ void add_refine_command(CLI::App& app, Runner& runner) {
                 "CFL bound: local (Δt from the mean edge, each vertex moves at most cfl/(2√3) of its own shortest "
                 "edge; default) or global (the thesis: every vertex within cfl/(2√3) of the mesh's shortest edge)")
       ->check(CLI::IsMember({"local", "global"}));
+  c->add_option("--step-control", args->step_control,
+                "Halve the steps after an iteration that raised Σg/vertex, grow them back after one that lowered it")
+      ->check(CLI::IsMember({"on", "off"}));
+  c->add_flag("--keep-inside-silhouettes", o.keep_inside_silhouettes,
+               "Keep the surface inside the visual hull of the used views' silhouettes (photographs on a dark "
+               "background)");
+  c->add_option("--silhouette-threshold", o.silhouettes.threshold,
+                "Silhouettes for --keep-inside-silhouettes: largest channel above this (on [0,1])")
+      ->capture_default_str();
+  c->add_option("--silhouette-dilate", o.silhouettes.dilate, "... dilated by this many pixels")->capture_default_str();
   c->add_flag("--no-adaptive", args->no_adaptive, "Skip adaptive refinement between iterations");
   c->add_option("--exclude-views", o.excluded_views, "0-based views not to use (held out)")->delimiter(',');
   c->add_flag("--ascii", args->ascii, "Write PLY as ASCII");
