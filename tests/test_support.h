@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <array>
@@ -24,8 +25,9 @@ class ScratchFolder {
  public:
   ScratchFolder() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            (std::string("mvflow-") + info->test_suite_name() + "-" + info->name());
+    // The process id too: two checkouts' suites may run at once on one machine.
+    path_ = std::filesystem::temp_directory_path() / (std::string("mvflow-") + info->test_suite_name() + "-" +
+                                                      info->name() + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
