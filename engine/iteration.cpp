@@ -40,6 +40,7 @@ void IterationData::reset_topology() {
   blocks = split_into_blocks(mesh.n_vertices(), options.block_size);
   partials.assign(blocks.size(), BlockPartial{});
   new_positions.assign(mesh.n_vertices(), Eigen::Vector3d::Zero());
+  moved.assign(mesh.n_vertices(), 0.0);
   block_seconds.assign(blocks.size(), {});
   refit_needed = false;
   step_scale = 1.0;  // Σg/vertex of another mesh says nothing about the steps on this one
@@ -96,7 +97,18 @@ void IterationData::cfl() {
                                   : MoveLimit{.distance = cfl_fraction * shortest_edge};
   moving = 0;
   for (std::uint8_t bits : fields.defined) moving += (bits & kSpeedDefined) != 0;
-  median_move = std::min(time_step * median_speed(mesh, fields), cfl_fraction * step_edge) / shortest_edge;
+}
+
+void IterationData::measure_moves() {
+  if (cancelled()) return;
+  std::vector<double> relative;
+  relative.reserve(moved.size());
+  for (std::uint32_t id = 0; id < moved.size(); ++id) {
+    if (!(fields.defined[id] & kSpeedDefined) || mesh.is_boundary(TriMesh::VertexHandle(static_cast<int>(id)))) continue;
+    const double edge = options.local_step ? fields.local_edge[id] : shortest_edge;
+    relative.push_back(edge > 0 ? moved[id] / edge : 0.0);
+  }
+  median_move = median_of(relative);
 }
 
 void IterationData::adapt_step_scale() {
@@ -112,7 +124,7 @@ void IterationData::adapt_step_scale() {
 void IterationData::move(std::size_t block) {
   if (cancelled()) return;
   StageTimer timer(block_seconds[block][static_cast<int>(Stage::Move)]);
-  move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside);
+  move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside, &moved);
 }
 
 void IterationData::smooth(std::size_t block) {
@@ -149,6 +161,7 @@ void run_iteration_sequential(IterationData& data) {
     for (std::size_t b = 0; b < n; ++b) data.regularize(b);
     for (std::size_t b = 0; b < n; ++b) data.commit(b);
   }
+  data.measure_moves();
 }
 
 }  // namespace mvflow

@@ -42,6 +42,7 @@ struct IterationData {
   std::vector<IndexRange> blocks;
   std::vector<BlockPartial> partials;            //!< one per block
   std::vector<Eigen::Vector3d> new_positions;    //!< Jacobi buffer of smoothing / regularization
+  std::vector<double> moved;                     //!< length of each vertex's move this iteration
   std::vector<std::array<double, kStageCount>> block_seconds;  //!< per block, per stage
 
   // Set before the iteration runs.
@@ -55,7 +56,9 @@ struct IterationData {
   MoveLimit move_limit;      //!< the CFL bound on one vertex's move
   double step_scale = 1.0;   //!< the fraction of the CFL step taken (step control), reset with the topology
   double previous_g_per_vertex = 0.0;  //!< Σg/vertex of the previous iteration on this topology
-  double median_move = 0.0;  //!< in units of e_min
+  //! Set by measure_moves(): the median over the moving vertices of their move divided by the
+  //! edge the CFL bound used for them (their own shortest edge, or e_min with the global bound).
+  double median_move = 0.0;
   std::size_t moving = 0;
   double serial_seconds[kStageCount] = {};
 
@@ -71,6 +74,7 @@ struct IterationData {
   void cfl();                          //!< serial: combine partials in block order, Δt, median move
   void adapt_step_scale();             //!< part of cfl(): the step control
   void move(std::size_t block);        //!< P ← P + Δt·F
+  void measure_moves();                //!< serial, after the iteration: median_move
   void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
   void regularize(std::size_t block);  //!< normals at the current positions, then regularization
   void commit(std::size_t block);      //!< new positions into the mesh

@@ -49,6 +49,7 @@ IterationGraph::IterationGraph(IterationData& data) : n_blocks_(data.blocks.size
     last = phase(last, &IterationData::regularize);
     last = phase(last, &IterationData::commit);
   }
+  flow::make_edge(*last, *add([&data] { data.measure_moves(); }));
 }
 
 void IterationGraph::run() {

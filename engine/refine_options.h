@@ -39,10 +39,11 @@ struct RefineOptions {
   VisibilityOptions visibility;
   PhotoGradientOptions photo;          //!< Savitzky–Golay window and the photo-consistency patch
   SpeedOptions speed;                  //!< balloon velocity v
-  double cfl = 1.0;                    //!< Δt = cfl·(e_min/2)/(√3·|F|_q) (SPEC §4; thesis 1)
+  //! Δt = cfl·(e/2)/(√3·|F|_q), e the mean edge (local_step) or e_min (SPEC §4; thesis 1)
+  double cfl = 1.0;
   //! q, the quantile of |F| over the moving vertices that sets Δt; in (0, 1]. 1 = max|F|, the
-  //! thesis's CFL rule. Below 1, vertices faster than |F|_q move the CFL distance
-  //! cfl·e_min/(2√3) along F, no more, so no vertex ever moves farther than under the thesis's rule.
+  //! thesis's CFL rule. Below 1, vertices faster than |F|_q move only their CFL distance along F
+  //! (cfl/(2√3) of their own shortest edge with local_step, of e_min without).
   double speed_quantile = 0.9;
   //! Local CFL: Δt uses the mean edge instead of the shortest, and each vertex moves at most
   //! cfl/(2√3) of its own shortest edge, so one short edge slows only its own vertices. false:

@@ -30,7 +30,9 @@ struct IterationReport {
   double shortest_edge = 0.0;         //!< e_min of the mesh the iteration started from
   double max_speed = 0.0;             //!< max |F|
   double time_step = 0.0;             //!< Δt (CFL)
-  double median_move = 0.0;           //!< median |Δt·F| over moving vertices, in units of e_min
+  //! median over the moving vertices of their move divided by the edge the CFL bound used for them
+  //! (their own shortest edge with the local bound, e_min with the global one)
+  double median_move = 0.0;
   std::string stop;                   //!< "continue", or why the refinement stops after it
   double seconds = 0.0;               //!< wall time of the whole iteration
   std::array<double, kStageCount> stage_seconds{};

@@ -156,7 +156,7 @@ class Refinement {
         break;
       }
       fill_report(report, edges, refinement_seconds, iteration_start);
-      StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move);
+      StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move, data_.total.defined_g);
       report.stop = to_string(reason);
       const bool budget_left = stopping.iterations() < static_cast<std::size_t>(options_.stopping.max_iterations);
       if (budget_left && refine_at_convergence(reason, report)) {

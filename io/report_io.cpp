@@ -20,7 +20,7 @@ nlohmann::json iteration_json(const IterationReport& r) {
           {"shortest_edge", r.shortest_edge},
           {"max_speed", r.max_speed},
           {"time_step", r.time_step},
-          {"median_move_over_shortest_edge", r.median_move},
+          {"median_move_over_cfl_edge", r.median_move},
           {"stop", r.stop},
           {"seconds", r.seconds},
           {"stage_seconds", stages}};

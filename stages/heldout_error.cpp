@@ -121,12 +121,26 @@ std::vector<Eigen::Vector3d> face_normals(const IndexedMesh& mesh) {
 
 }  // namespace
 
+namespace {
+
+// The mesh as flat arrays, refusing what cannot be rendered (the caller names the file).
+IndexedMesh checked_mesh(const Mesh& mesh) {
+  if (mesh.n_faces() == 0) throw InputError("the mesh to score has no faces");
+  IndexedMesh flat = to_indexed(mesh);
+  for (std::size_t v = 0; v < flat.positions.size(); ++v)
+    if (!flat.positions[v].allFinite())
+      throw InputError("the mesh to score has a non-finite coordinate at vertex " + std::to_string(v));
+  return flat;
+}
+
+}  // namespace
+
 HeldoutRenderer::HeldoutRenderer(const Scene& scene, const Mesh& mesh, std::vector<int> held_out,
                                  const HeldoutOptions& options)
     : scene_(scene),
       held_out_(checked_held_out(scene, std::move(held_out), options)),
       options_(options),
-      flat_(to_indexed(mesh)),
+      flat_(checked_mesh(mesh)),
       face_normals_(face_normals(flat_)),
       mean_edge_(edge_lengths(mesh.topology).mean),
       surface_(flat_) {

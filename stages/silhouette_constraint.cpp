@@ -17,9 +17,10 @@ SilhouetteConstraint::SilhouetteConstraint(const std::vector<PhotoView>& views, 
 bool SilhouetteConstraint::admits(const Eigen::Vector3d& X) const {
   for (std::size_t i = 0; i < views_.size(); ++i) {
     const Projection p = views_[i].project(X);
-    if (!(p.depth > 0)) continue;
+    // Behind the camera or outside the image (NaN included): this view says nothing.
+    if (!(p.depth > 0) || !views_[i].camera->in_image(p.u, p.v)) continue;
     const long x = std::lround(p.u), y = std::lround(p.v);
-    if (x < 0 || y < 0 || x >= masks_[i].width || y >= masks_[i].height) continue;  // outside: says nothing
+    if (x < 0 || y < 0 || x >= masks_[i].width || y >= masks_[i].height) continue;
     if (!masks_[i].at(static_cast<int>(x), static_cast<int>(y))) return false;
   }
   return true;

@@ -81,13 +81,15 @@ void compute_local_edges(const TriMesh& mesh, IndexRange vertices, VertexFields&
 }
 
 void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt, const MoveLimit& limit,
-                   const SilhouetteConstraint* inside) {
+                   const SilhouetteConstraint* inside, std::vector<double>* moved) {
   MVFLOW_CHECK(dt >= 0.0 && std::isfinite(dt), "move_vertices: dt must be finite and >= 0");
   MVFLOW_CHECK(limit.distance > 0.0 && limit.local_edge_fraction >= 0.0, "move_vertices: invalid move limit");
   detail::check_range(vertices, mesh.n_vertices(), "move_vertices");
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "move_vertices: fields are not sized for the mesh");
+  MVFLOW_CHECK(!moved || moved->size() == mesh.n_vertices(), "move_vertices: moved is not sized for the mesh");
   for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
     const auto v = detail::handle(id);
+    if (moved) (*moved)[id] = 0.0;
     if (!(fields.defined[id] & kSpeedDefined) || mesh.is_boundary(v)) continue;
     Eigen::Vector3d step = dt * fields.speed[id];
     double longest = limit.distance;
@@ -95,7 +97,9 @@ void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& field
     const double length = step.norm();
     if (length > longest) step *= longest / length;
     const Eigen::Vector3d from = to_eigen(mesh.point(v));
-    mesh.set_point(v, to_openmesh(inside ? inside->limit_move(from, from + step) : from + step));
+    const Eigen::Vector3d to = inside ? inside->limit_move(from, from + step) : from + step;
+    mesh.set_point(v, to_openmesh(to));
+    if (moved) (*moved)[id] = (to - from).norm();
   }
 }
 
@@ -123,15 +127,16 @@ double speed_quantile(const TriMesh& mesh, const VertexFields& fields, double qu
   return *nth;
 }
 
-double median_speed(const TriMesh& mesh, const VertexFields& fields) {
-  std::vector<double> speeds = moving_speeds(mesh, fields);
-  if (speeds.empty()) return 0.0;
-  const std::size_t upper = speeds.size() / 2;
-  std::nth_element(speeds.begin(), speeds.begin() + upper, speeds.end());
-  if (speeds.size() % 2 == 1) return speeds[upper];
+double median_of(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const std::size_t upper = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(upper), values.end());
+  if (values.size() % 2 == 1) return values[upper];
   // Even count: mean of the two middle values; the lower one is the max of the lower half.
-  const double lower = *std::max_element(speeds.begin(), speeds.begin() + upper);
-  return 0.5 * (lower + speeds[upper]);
+  const double lower = *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(upper));
+  return 0.5 * (lower + values[upper]);
 }
+
+double median_speed(const TriMesh& mesh, const VertexFields& fields) { return median_of(moving_speeds(mesh, fields)); }
 
 }  // namespace mvflow

@@ -81,13 +81,19 @@ struct MoveLimit {
 //! \param limit    How far one vertex may move; a faster vertex moves that far along F. No limit
 //!                 (the default) moves every vertex by dt·F, as the thesis does.
 //! \param inside   When given, no vertex leaves the visual hull (SilhouetteConstraint::limit_move).
+//! \param moved    When given (#V entries), moved[v] = the length of v's move for v in \p vertices
+//!                 (0 for a vertex that did not move).
 void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& fields, double dt,
-                   const MoveLimit& limit = {}, const SilhouetteConstraint* inside = nullptr);
+                   const MoveLimit& limit = {}, const SilhouetteConstraint* inside = nullptr,
+                   std::vector<double>* moved = nullptr);
 
 //! The median of |F| over the moving vertices (kSpeedDefined, not boundary); 0 if none.
 //! Δt times this, divided by e_min, is what the step-small stopping rule reads (SPEC §4).
 //! Allocates one buffer per call (a global reduction, not a per-block stage).
 double median_speed(const TriMesh& mesh, const VertexFields& fields);
+
+//! The median of \p values (the mean of the two middle ones for an even count); 0 when empty.
+double median_of(std::vector<double> values);
 
 //! The \p quantile (in (0, 1]; 1 = the maximum) of |F| over the moving vertices, the value at
 //! rank ceil(quantile·n) − 1 of the sorted speeds; 0 if none move. Allocates one buffer.

@@ -49,10 +49,15 @@ double StoppingCriterion::change_percent(std::size_t lag) const {
 bool StoppingCriterion::converged() const {
   const auto w = static_cast<std::size_t>(options_.lookback);
   if (options_.test == ConvergenceTest::NoImprovement) {
-    const auto split = history_.end() - static_cast<std::ptrdiff_t>(w);  // ≥ 1 value before it
-    const double recent = *std::min_element(split, history_.end());
-    const double earlier = *std::min_element(history_.begin(), split);
-    if (!(recent == recent) || !(earlier == earlier)) return false;  // NaN never converges
+    // A NaN in the window holds convergence off; earlier NaNs are skipped.
+    const std::vector<double>& g = history_per_vertex_;
+    const auto split = g.end() - static_cast<std::ptrdiff_t>(w);  // ≥ 1 value before it
+    if (std::any_of(split, g.end(), [](double x) { return std::isnan(x); })) return false;
+    const double recent = *std::min_element(split, g.end());
+    double earlier = std::numeric_limits<double>::infinity();
+    for (auto it = g.begin(); it != split; ++it)
+      if (*it < earlier) earlier = *it;  // false for NaN
+    if (std::isinf(earlier)) return false;
     if (earlier == 0.0) return true;  // nothing left to improve
     return 100.0 - 100.0 * recent / earlier < options_.epsilon_percent;
   }
@@ -64,6 +69,7 @@ bool StoppingCriterion::converged() const {
 void StoppingCriterion::restart() {
   before_restart_ += history_.size();
   history_.clear();
+  history_per_vertex_.clear();
 }
 
 std::vector<double> StoppingCriterion::last_changes_percent() const {
@@ -74,8 +80,9 @@ std::vector<double> StoppingCriterion::last_changes_percent() const {
   return changes;
 }
 
-StopReason StoppingCriterion::add_iteration(double sum_g, double median_move_over_emin) {
+StopReason StoppingCriterion::add_iteration(double sum_g, double median_move_over_emin, std::size_t vertices_with_g) {
   history_.push_back(sum_g);
+  history_per_vertex_.push_back(vertices_with_g > 0 ? sum_g / static_cast<double>(vertices_with_g) : sum_g);
   if (history_.size() >= static_cast<std::size_t>(options_.min_iterations)) {
     if (converged()) return StopReason::Converged;
     if (median_move_over_emin < options_.median_move_tolerance) return StopReason::StepSmall;

@@ -22,10 +22,11 @@ enum class ConvergenceTest {
   //! alternates between two values, as it does once the fastest vertices step across the
   //! minimum of g and back.
   EachLookback,
-  //! No improvement: the lowest G of the last `lookback` iterations is not ε % below the lowest
-  //! G before them, 100 − 100·min(G_{i−w+1..i})/min(G_1..G_{i−w}) < ε with w = lookback (early
-  //! stopping with patience w). An alternation around a level no longer lowers the minimum, so
-  //! it stops.
+  //! No improvement: the lowest g_i = G_i/n_i (Σg per vertex with defined g, so that a change of
+  //! the vertex count does not count as a change of the surface) of the last `lookback`
+  //! iterations is not ε % below the lowest before them,
+  //! 100 − 100·min(g_{i−w+1..i})/min(g_1..g_{i−w}) < ε with w = lookback (early stopping with
+  //! patience w). An alternation around a level no longer lowers the minimum, so it stops.
   NoImprovement,
 };
 
@@ -68,9 +69,12 @@ class StoppingCriterion {
 
   //! Records iteration i = iterations() + 1 and returns whether to stop after it.
   //! \param sum_g               G_i = Σ g(P) over the vertices with defined g, ≥ 0.
-  //! \param median_move_over_emin median over the moving vertices of |Δt·F(P)| divided by the
-  //!                              shortest edge; pass 0 when nothing moved (NaN never fires).
-  StopReason add_iteration(double sum_g, double median_move_over_emin);
+  //! \param median_move_over_emin median over the moving vertices of their move divided by the
+  //!                              edge length the CFL bound uses for them; 0 when nothing moved
+  //!                              (NaN never fires).
+  //! \param vertices_with_g      n_i, the vertices with defined g (NoImprovement compares G_i/n_i);
+  //!                              0 when unknown: G_i itself is compared.
+  StopReason add_iteration(double sum_g, double median_move_over_emin, std::size_t vertices_with_g = 0);
 
   //! Starts the Converged and StepSmall rules afresh (after a change of the mesh's resolution Σg
   //! sums over other vertices); the iteration count for MaxIterations goes on.
@@ -89,7 +93,8 @@ class StoppingCriterion {
   bool converged() const;
 
   StoppingOptions options_;
-  std::vector<double> history_;  // G since the start or the last restart
+  std::vector<double> history_;            // G since the start or the last restart
+  std::vector<double> history_per_vertex_;  // G/n (or G where n is unknown), the same iterations
   std::size_t before_restart_ = 0;
 };
 

@@ -71,7 +71,7 @@ TEST(CliHeldout, MasksFolderIsMatchedByImageName) {
   const auto missing =
       test::run_mvflow("heldout " + scene_and_mesh() + " --views 2 --masks " + (folder / "empty").string());
   EXPECT_EQ(missing.exit_code, 1) << missing.output;
-  EXPECT_NE(missing.output.find("no mask for image view02.png"), std::string::npos) << missing.output;
+  EXPECT_NE(missing.output.find("no mask for view 2 (view02.png)"), std::string::npos) << missing.output;
 }
 
 }  // namespace

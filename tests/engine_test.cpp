@@ -64,7 +64,13 @@ std::vector<RefineOptions> determinism_cases() {
   thesis_rules.speed_quantile = 1.0;
   thesis_rules.local_step = false;
   thesis_rules.refinement_schedule = RefinementSchedule::EveryIteration;
-  return {by_default, thesis_rules};
+  // The optional rules: step control, and the silhouette constraint (with a threshold that cuts
+  // the textured background into many pieces, so that the constraint holds vertices back often).
+  RefineOptions optional_rules = by_default;
+  optional_rules.step_control = true;
+  optional_rules.keep_inside_silhouettes = true;
+  optional_rules.silhouettes.threshold = 0.6;
+  return {by_default, thesis_rules, optional_rules};
 }
 
 void expect_same_bits(const RefineOptions& options) {
@@ -117,14 +123,39 @@ TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {
               after.symmetric_mean(), before.accuracy(), after.accuracy(), result.summary.initial_sum_g_per_vertex,
               result.summary.final_sum_g_per_vertex, result.summary.initial_vertices, result.summary.final_vertices,
               result.summary.self_intersections);
-  // Measured (this scene, 40 iterations, 300 → 3692 vertices): mean 0.0294 → 0.0049, accuracy
-  // 0.0526 → 0.0096. tests/quality_test.cpp checks the full pipeline on the README's scenes.
+  // Measured (this scene, 40 iterations, 300 → 3827 vertices): mean 0.0294 → 0.0048, accuracy
+  // 0.0526 → 0.0091. tests/quality_test.cpp checks the full pipeline on the README's scenes.
   EXPECT_LT(after.symmetric_mean(), 0.5 * before.symmetric_mean());
   EXPECT_LT(after.accuracy(), 0.5 * before.accuracy());
   EXPECT_LT(result.summary.final_sum_g_per_vertex, result.summary.initial_sum_g_per_vertex);
   EXPECT_EQ(result.summary.self_intersections, 0u);
   EXPECT_EQ(result.mesh.quality.size(), result.mesh.n_vertices());
   EXPECT_EQ(result.mesh.colors.size(), result.mesh.n_vertices());
+}
+
+TEST(Refiner, RefinesCoarseToFineWhenTheFlowHasConverged) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = few_iterations(16);
+  options.stopping.min_iterations = 6;
+  options.stopping.epsilon_percent = 50.0;  // "converged" as soon as the rules may fire
+  const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+  const auto& iterations = result.summary.iterations;
+  ASSERT_LE(iterations.size(), 16u);  // the budget counts over the restarts
+  std::size_t refinements = 0;
+  for (std::size_t i = 0; i < iterations.size(); ++i) {
+    if (!iterations[i].stop.starts_with("refined (")) continue;
+    ++refinements;
+    EXPECT_GT(iterations[i].refined_faces, 0u);
+    // The stopping rules start afresh: the next refinement comes min_iterations later at the earliest.
+    for (std::size_t j = i + 1; j < std::min(iterations.size(), i + 6); ++j)
+      EXPECT_FALSE(iterations[j].stop.starts_with("refined")) << j;
+    if (i + 1 < iterations.size()) {
+      EXPECT_GT(iterations[i + 1].vertices, iterations[i].vertices);
+    }
+  }
+  EXPECT_GE(refinements, 1u);
+  EXPECT_EQ(result.mesh.n_vertices(), iterations.back().vertices);
 }
 
 TEST(Refiner, CancelStopsBetweenBlocks) {

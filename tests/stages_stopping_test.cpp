@@ -136,6 +136,21 @@ TEST(Stopping, NoImprovementWaitsForEpsilonAndRestartsWithTheResolution) {
   EXPECT_EQ(criterion.add_iteration(5.0, large_move), StopReason::MaxIterations);
 }
 
+TEST(Stopping, NoImprovementComparesSumsPerVertexAndNeverConvergesOnNaN) {
+  // Σg grows with the vertex count (refinement) while Σg per vertex falls 2 % per iteration: an
+  // improvement, not convergence.
+  StoppingCriterion criterion{StoppingOptions{}};
+  for (int i = 1; i <= 30; ++i) {
+    const std::size_t vertices = 1000u * static_cast<std::size_t>(i);
+    EXPECT_EQ(criterion.add_iteration(static_cast<double>(vertices) * std::pow(0.98, i), large_move, vertices),
+              StopReason::Continue) << i;
+  }
+  // A NaN at iteration 9 holds convergence off while it is among the last five (10..13).
+  std::vector<double> g(30, 5.0);
+  g[8] = std::nan("");
+  EXPECT_EQ(run(g, large_move, StoppingOptions{}), std::make_pair(std::size_t{14}, StopReason::Converged));
+}
+
 TEST(Stopping, ReportsTheLastChanges) {
   StoppingCriterion criterion{StoppingOptions{}};
   criterion.add_iteration(100.0, 1.0);

@@ -11,6 +11,7 @@
 #include "engine/error.h"
 #include "io/atomic_write.h"
 #include "io/image_io.h"
+#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
 #include "stages/heldout_error.h"
@@ -35,25 +36,6 @@ struct HeldoutArguments {
   SilhouetteOptions silhouette;
   HeldoutOptions options;
 };
-
-// The mask of \p view in \p folder: the file with the view's image name, else its stem + ".png"
-// (masks are often PNGs beside JPEG photographs). Non-zero = object.
-Mask read_view_mask(const fs::path& folder, const View& view) {
-  const fs::path name = fs::path(view.image_name).filename();
-  const fs::path png = fs::path(name).replace_extension(".png");
-  fs::path file = folder / name;
-  if (!fs::is_regular_file(file)) file = folder / png;
-  if (!fs::is_regular_file(file))
-    throw InputError(folder, 0,
-                     fmt::format("no mask for image {} (looked for {}{})", name.string(), name.string(),
-                                 png == name ? std::string() : " and " + png.string()));
-  const Image image = io::read_image(file);
-  if (image.width() != view.camera.width() || image.height() != view.camera.height())
-    throw InputError(file, 0,
-                     fmt::format("the mask is {}x{}, its view's camera is {}x{}", image.width(),
-                                 image.height(), view.camera.width(), view.camera.height()));
-  return mask_from_image(image);
-}
 
 // +inf and NaN have no JSON number: null stands for them (PSNR of identical images, no scored pixel).
 nlohmann::json number_or_null(double x) {
@@ -95,6 +77,7 @@ int run_heldout(const HeldoutArguments& args, spdlog::logger& log) {
   const Scene scene = io::load_scene(args.scene);
   MeshBuildReport build;
   const Mesh mesh = io::load_mesh(args.mesh, &build);
+  if (mesh.n_faces() == 0) throw InputError(args.mesh, 0, "the mesh has no faces to render");
   if (build.rejected_faces > 0)
     log.warn("{}: {} face(s) would make the mesh non-manifold and are not rendered", args.mesh,
              build.rejected_faces);
@@ -122,7 +105,9 @@ int run_heldout(const HeldoutArguments& args, spdlog::logger& log) {
     const auto i = static_cast<std::size_t>(view);
     real_silhouettes.push_back(
         args.masks.empty() ? threshold_silhouette(scene.image(i), args.silhouette)
-                           : dilate_mask(read_view_mask(args.masks, scene.views[i]), args.silhouette.dilate));
+                           : dilate_mask(mask_from_image(io::read_mask_image(io::find_mask_file(args.masks, scene.views[i], i),
+                                                                            scene.views[i], i)),
+                                         args.silhouette.dilate));
   }
 
   fmt::print("{:>5}  {:<24} {:>9} {:>9} {:>11} {:>8} {:>8}\n", "view", "image", "MAE", "PSNR dB",

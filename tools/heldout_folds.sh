@@ -8,8 +8,8 @@
 # neither the hull, the refinement nor the colouring ever sees a held-out photograph. Prints one
 # line per fold and the mean over the folds; everything is kept under OUT/fold_F/.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-mvflow=build/tools/mvflow
+mvflow=$(cd "$(dirname "$0")/.." && pwd)/build/tools/mvflow
+[ -x "$mvflow" ] || { echo "$0: $mvflow is missing: build first (bash tools/build.sh)" >&2; exit 1; }
 
 [ $# -ge 2 ] || { echo "usage: $0 SCENE OUT [--folds K] [--dilate PX] [--threshold T] [-- REFINE OPTIONS...]" >&2; exit 2; }
 scene=$1 out=$2
@@ -28,12 +28,21 @@ refine_options=("$@")
 
 mkdir -p "$out"
 rm -f "$out/scores.tmp"
-"$mvflow" info "$scene" --json "$out/scene.json" > /dev/null
+step "$out/scene.log" "$mvflow" info "$scene" --json "$out/scene.json"
 views=$(grep -m1 -o '"count": *[0-9]*' "$out/scene.json" | grep -o '[0-9]*$')
 
+# Runs a step, its output in LOG; on failure says which and shows the log's end.
+step() {
+  local log=$1
+  shift
+  "$@" > "$log" 2>&1 || { echo "$0: failed: $* (log: $log)" >&2; tail -5 "$log" >&2; exit 1; }
+}
+
 # "MAE PSNR silhouette" of the pooled line of `mvflow heldout`.
-score() { "$mvflow" heldout "$scene" "$1" --views "$2" --threshold "$threshold" --json "$3" 2>/dev/null |
-            awk '$1 == "all" { print $2, $3, $4 }'; }
+score() {
+  step "$3.log" "$mvflow" heldout "$scene" "$1" --views "$2" --threshold "$threshold" --json "$3"
+  awk '$1 == "all" { print $2, $3, $4 }' "$3.log"
+}
 
 printf '%-5s %-12s %28s %28s %s\n' fold views "hull: MAE PSNR silhouette" "refined: MAE PSNR silhouette" \
   "refined vertices, Σg/vertex before → after, seconds"
@@ -41,12 +50,12 @@ for ((f = 0; f < folds; ++f)); do
   held=$(seq -s, "$f" "$folds" $((views - 1)))
   dir=$out/fold_$f
   mkdir -p "$dir"
-  "$mvflow" hull "$scene" -o "$dir/hull.ply" --threshold "$threshold" --dilate "$dilate" --exclude-views "$held" \
-    > "$dir/hull.log" 2>&1
-  start=$(date +%s.%N)
-  "$mvflow" refine "$scene" --mesh "$dir/hull.ply" --exclude-views "$held" -o "$dir/refined.ply" \
-    --report "$dir/report.json" "${refine_options[@]}" > "$dir/refine.log" 2>&1
-  seconds=$(echo "$(date +%s.%N) - $start" | bc)
+  step "$dir/hull.log" "$mvflow" hull "$scene" -o "$dir/hull.ply" --threshold "$threshold" --dilate "$dilate" \
+    --exclude-views "$held"
+  start=$(date +%s%N)
+  step "$dir/refine.log" "$mvflow" refine "$scene" --mesh "$dir/hull.ply" --exclude-views "$held" \
+    -o "$dir/refined.ply" --report "$dir/report.json" "${refine_options[@]}"
+  seconds=$(awk -v a="$start" -v b="$(date +%s%N)" 'BEGIN { print (b - a) / 1e9 }')
   hull_score=$(score "$dir/hull.ply" "$held" "$dir/hull_heldout.json")
   refined_score=$(score "$dir/refined.ply" "$held" "$dir/refined_heldout.json")
   vertices=$(grep -o '→ [0-9]* vertices' "$dir/refine.log" | grep -o '[0-9]*')

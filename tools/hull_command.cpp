@@ -132,7 +132,7 @@ int run_hull(const HullArguments& args, spdlog::logger& log) {
 
   const Mesh mesh = build_mesh(hull.mesh, args.output);
   const MeshStats stats = compute_mesh_stats(mesh);
-  fmt::print("silhouettes {} views, {}", scene.size(),
+  fmt::print("silhouettes {} views, {}", used.size(),
              args.masks.empty() ? fmt::format("threshold {}", args.silhouette.threshold)
                                 : fmt::format("mask files from {}", args.masks));
   fmt::print(", dilated by {} px, holes up to {} % of the image filled\n", args.silhouette.dilate, 100 * args.fill_holes);
