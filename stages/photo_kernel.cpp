@@ -1,0 +1,67 @@
+#include "stages/photo_kernel.h"
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "engine/error.h"
+
+// The 8-lane vector types are passed only between always-inlined functions of one build.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace mvflow::detail {
+
+namespace baseline {
+#include "stages/photo_kernel_body.inc"
+}  // namespace baseline
+
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace avx2 {
+#include "stages/photo_kernel_body.inc"
+}  // namespace avx2
+#pragma GCC pop_options
+
+#pragma GCC push_options
+#pragma GCC target("arch=x86-64-v4")
+#pragma GCC diagnostic push
+// GCC 12's _mm512_cvtps_pd starts from _mm512_undefined_pd() and warns about it.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#define MVFLOW_KERNEL_AVX512
+namespace avx512 {
+#include "stages/photo_kernel_body.inc"
+}  // namespace avx512
+#undef MVFLOW_KERNEL_AVX512
+#pragma GCC diagnostic pop
+#pragma GCC pop_options
+
+// GCC function multiversioning: a resolver picks one build at load time. Callers in other
+// files see only the unversioned functions below (GCC dispatches only where every version is
+// visible).
+#define MVFLOW_VERSIONED(target_name, build)                                                              \
+  __attribute__((target(target_name))) PhotoValue evaluate_5x5(                                           \
+      const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views) { \
+    return build::photo_consistency_5x5(X, view_ids, views);                                              \
+  }
+MVFLOW_VERSIONED("default", baseline)
+MVFLOW_VERSIONED("avx2", avx2)
+MVFLOW_VERSIONED("arch=x86-64-v4", avx512)
+#undef MVFLOW_VERSIONED
+
+PhotoValue photo_consistency_5x5(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
+                                 const std::vector<PhotoView>& views) {
+  return evaluate_5x5(X, view_ids, views);
+}
+
+std::vector<PhotoKernelBuild> photo_kernel_builds() {
+  std::vector<PhotoKernelBuild> builds{{"baseline", &baseline::photo_consistency_5x5}};
+  if (__builtin_cpu_supports("avx2")) builds.push_back({"avx2", &avx2::photo_consistency_5x5});
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512cd"))
+    builds.push_back({"avx512", &avx512::photo_consistency_5x5});
+  return builds;
+}
+
+}  // namespace mvflow::detail

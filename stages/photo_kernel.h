@@ -1,0 +1,31 @@
+#pragma once
+// The hot loops of the photo stages for the default 5×5 patch (SPEC §3), in three builds of the
+// same source (x86-64 baseline, AVX2, AVX-512), the fastest one the CPU runs chosen once at load
+// time (GCC function multiversioning). Every build gives the same bits: each value is computed
+// by the same double operations in the same order (no FMA contraction), only the lane width
+// differs. Callers use photo_consistency().
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "stages/photo_consistency.h"
+#include "stages/photo_views.h"
+
+namespace mvflow::detail {
+
+//! g at \p X over the views \p view_ids with the 5×5 patch; photo_consistency() with
+//! half_patch = 2.
+PhotoValue photo_consistency_5x5(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
+                                 const std::vector<PhotoView>& views);
+
+//! One build of the kernels, for tests that check that the builds agree bit for bit.
+struct PhotoKernelBuild {
+  const char* name;  //!< "baseline", "avx2" or "avx512"
+  PhotoValue (*consistency)(const Eigen::Vector3d&, std::span<const std::uint16_t>, const std::vector<PhotoView>&);
+};
+//! The builds this CPU can run, baseline first.
+std::vector<PhotoKernelBuild> photo_kernel_builds();
+
+}  // namespace mvflow::detail
