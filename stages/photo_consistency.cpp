@@ -14,21 +14,20 @@ namespace {
 constexpr int kMaxSide = 15;  // 2·7 + 1
 constexpr int kMaxValues = 3 * kMaxSide * kMaxSide;
 
-// g for any patch size (the default 5×5 has its own kernel, stages/photo_kernel.h). Value
-// (dy, dx, c) is element (dy+h)·3·side + 3·(dx+h) + c, so a patch row is 3·side contiguous floats
-// of the image read at two horizontal offsets (0 and 3 = the next pixel) in two image rows: loops
-// the compiler vectorizes, each value computed as the scalar formula w00·a + w10·b + w01·c + w11·d.
+// g for any patch size (the default 5×5 has its own kernel, stages/photo_kernel.h) with the same
+// arithmetic: each value interpolated in float, h = a + fx·(b − a) along the row, then
+// C = h + fy·(h' − h) down, and g = (Σ C² − Σ_values (Σ_i C)²/m) / ((m − 1)·side²) from sums in
+// double. A patch row is 3·side contiguous floats, read at two horizontal offsets (0 and 3 = the
+// next pixel): loops the compiler vectorizes.
 __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 PhotoValue photo_consistency_any(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                                  const std::vector<PhotoView>& views, int h) {
   const int side = 2 * h + 1;
   const int width = 3 * side;
   const int values = width * side;
-  // Per (offset, channel): Σ C and Σ C² over the views, in double (SPEC §3).
-  std::array<double, kMaxValues> sum;
-  std::array<double, kMaxValues> sum_squares;
+  std::array<double, kMaxValues> sum;  // Σ_i C per value
   std::fill_n(sum.begin(), values, 0.0);
-  std::fill_n(sum_squares.begin(), values, 0.0);
+  double squares = 0.0;  // Σ_i Σ_values C²
   int used = 0;
   for (const std::uint16_t id : view_ids) {
     const PhotoView& view = views[id];
@@ -37,30 +36,32 @@ PhotoValue photo_consistency_any(const Eigen::Vector3d& X, std::span<const std::
     ++used;
     const int x0 = static_cast<int>(std::floor(p.u));
     const int y0 = static_cast<int>(std::floor(p.v));
-    // One set of bilinear weights serves the whole patch: the offsets are whole pixels.
-    const double fx = p.u - x0, fy = p.v - y0;
-    const double w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
+    // One pair of weights serves the whole patch: the offsets are whole pixels.
+    const float fx = static_cast<float>(p.u - x0), fy = static_cast<float>(p.v - y0);
     const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
-    const float* top = view.image->data() + static_cast<std::size_t>(y0 - h) * stride + static_cast<std::size_t>(x0 - h) * 3;
-    for (int r = 0; r < side; ++r, top += stride) {
-      const float* __restrict next = top + stride;
+    const float* row = view.image->data() + static_cast<std::size_t>(y0 - h) * stride + static_cast<std::size_t>(x0 - h) * 3;
+    std::array<float, 3 * kMaxSide> top, bottom;
+    for (int j = 0; j < width; ++j) top[j] = row[j] + fx * (row[j + 3] - row[j]);
+    for (int r = 0; r < side; ++r) {
+      row += stride;
+      for (int j = 0; j < width; ++j) bottom[j] = row[j] + fx * (row[j + 3] - row[j]);
       double* __restrict row_sum = sum.data() + r * width;
-      double* __restrict row_squares = sum_squares.data() + r * width;
       for (int j = 0; j < width; ++j) {
-        const double value = w00 * top[j] + w10 * top[j + 3] + w01 * next[j] + w11 * next[j + 3];
+        const double value = top[j] + fy * (bottom[j] - top[j]);
         row_sum[j] += value;
-        row_squares[j] += value * value;
+        squares += value * value;
       }
+      top = bottom;
     }
   }
   PhotoValue result;
   result.views = used;
   if (used < 2) return result;
   const double m = used;
-  double total = 0.0;
-  for (int k = 0; k < values; ++k) total += (sum_squares[k] - sum[k] * sum[k] / m) / (m - 1);
+  double sum_squared = 0.0;
+  for (int k = 0; k < values; ++k) sum_squared += sum[k] * sum[k];
   // Rounding can leave a tiny negative variance where all views agree; g is a variance sum.
-  result.g = std::max(0.0, total / (side * side));
+  result.g = std::max(0.0, (squares - sum_squared / m) / ((m - 1) * (side * side)));
   return result;
 }
 

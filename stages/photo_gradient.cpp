@@ -3,6 +3,7 @@
 #include <span>
 
 #include "engine/error.h"
+#include "stages/photo_kernel.h"
 
 namespace mvflow {
 
@@ -17,6 +18,9 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
                              double sample_spacing, VertexFields& fields) const {
   MVFLOW_CHECK(sample_spacing > 0, "photo gradient: sample spacing must be positive");
   const int half = options_.savitzky_golay.half_window();
+  const bool default_patch = options_.photo.half_patch == 2;
+  // Buffers for the whole block: no allocation per vertex.
+  std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half));
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     const std::span<const std::uint16_t> visible(fields.visible_views.data() + v * fields.view_capacity,
                                                  fields.visible_count[v]);
@@ -31,19 +35,31 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     fields.photo_consistency[v] = centre.g;
     defined |= kPhotoDefined;
 
+    // samples[axis·2·half + i]: s = −half..−1, 1..half (the centre is shared by the axes).
+    if (default_patch) {
+      detail::photo_consistency_5x5_axes(X, sample_spacing, half, visible, views, samples);
+    } else {
+      std::size_t k = 0;
+      for (int axis = 0; axis < 3; ++axis)
+        for (int s = -half; s <= half; ++s) {
+          if (s == 0) continue;
+          Eigen::Vector3d sample = X;
+          sample[axis] += s * sample_spacing;
+          samples[k++] = photo_consistency(sample, visible, views, options_.photo);
+        }
+    }
     Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
     bool complete = true;
     for (int axis = 0; axis < 3 && complete; ++axis) {
+      const PhotoValue* line = samples.data() + static_cast<std::size_t>(axis) * 2 * half;
       double derivative = 0.0;
       for (int s = -half; s <= half && complete; ++s) {
         const double c = coefficients_[static_cast<std::size_t>(s + half)];
         if (s == 0) {
-          derivative += c * centre.g;  // the centre sample is shared by the three axes
+          derivative += c * centre.g;
           continue;
         }
-        Eigen::Vector3d sample = X;
-        sample[axis] += s * sample_spacing;
-        const PhotoValue value = photo_consistency(sample, visible, views, options_.photo);
+        const PhotoValue& value = line[s < 0 ? s + half : s + half - 1];
         complete = value.defined();
         derivative += c * value.g;
       }

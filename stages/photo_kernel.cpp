@@ -44,6 +44,11 @@ namespace avx512 {
   __attribute__((target(target_name))) PhotoValue evaluate_5x5(                                           \
       const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views) { \
     return build::photo_consistency_5x5(X, view_ids, views);                                              \
+  }                                                                                                       \
+  __attribute__((target(target_name))) void evaluate_5x5_axes(                                            \
+      const Eigen::Vector3d& X, double spacing, int half, std::span<const std::uint16_t> view_ids,        \
+      const std::vector<PhotoView>& views, std::span<PhotoValue> samples) {                               \
+    build::photo_consistency_5x5_axes(X, spacing, half, view_ids, views, samples);                        \
   }
 MVFLOW_VERSIONED("default", baseline)
 MVFLOW_VERSIONED("avx2", avx2)
@@ -55,12 +60,21 @@ PhotoValue photo_consistency_5x5(const Eigen::Vector3d& X, std::span<const std::
   return evaluate_5x5(X, view_ids, views);
 }
 
+void photo_consistency_5x5_axes(const Eigen::Vector3d& X, double spacing, int half,
+                                std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
+                                std::span<PhotoValue> samples) {
+  MVFLOW_CHECK(samples.size() >= static_cast<std::size_t>(6 * half), "photo_consistency_5x5_axes: too few samples");
+  evaluate_5x5_axes(X, spacing, half, view_ids, views, samples);
+}
+
 std::vector<PhotoKernelBuild> photo_kernel_builds() {
-  std::vector<PhotoKernelBuild> builds{{"baseline", &baseline::photo_consistency_5x5}};
-  if (__builtin_cpu_supports("avx2")) builds.push_back({"avx2", &avx2::photo_consistency_5x5});
+  std::vector<PhotoKernelBuild> builds{
+      {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_axes}};
+  if (__builtin_cpu_supports("avx2"))
+    builds.push_back({"avx2", &avx2::photo_consistency_5x5, &avx2::photo_consistency_5x5_axes});
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
       __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512cd"))
-    builds.push_back({"avx512", &avx512::photo_consistency_5x5});
+    builds.push_back({"avx512", &avx512::photo_consistency_5x5, &avx512::photo_consistency_5x5_axes});
   return builds;
 }
 

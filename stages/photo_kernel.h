@@ -3,7 +3,7 @@
 // same source (x86-64 baseline, AVX2, AVX-512), the fastest one the CPU runs chosen once at load
 // time (GCC function multiversioning). Every build gives the same bits: each value is computed
 // by the same double operations in the same order (no FMA contraction), only the lane width
-// differs. Callers use photo_consistency().
+// differs. Callers use photo_consistency() and PhotoGradientStage.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -20,10 +20,19 @@ namespace mvflow::detail {
 PhotoValue photo_consistency_5x5(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                                  const std::vector<PhotoView>& views);
 
+//! g at X + s·spacing·e_a for a = x, y, z and s = −half..−1, 1..half (in that order,
+//! 6·half values into \p samples), over the views \p view_ids, 5×5 patch. For pinhole views the
+//! projection of the samples is P·X + s·spacing·P_a (linear in s), evaluated for 8 views at once.
+void photo_consistency_5x5_axes(const Eigen::Vector3d& X, double spacing, int half,
+                                std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
+                                std::span<PhotoValue> samples);
+
 //! One build of the kernels, for tests that check that the builds agree bit for bit.
 struct PhotoKernelBuild {
   const char* name;  //!< "baseline", "avx2" or "avx512"
   PhotoValue (*consistency)(const Eigen::Vector3d&, std::span<const std::uint16_t>, const std::vector<PhotoView>&);
+  void (*axes)(const Eigen::Vector3d&, double, int, std::span<const std::uint16_t>, const std::vector<PhotoView>&,
+               std::span<PhotoValue>);
 };
 //! The builds this CPU can run, baseline first.
 std::vector<PhotoKernelBuild> photo_kernel_builds();
