@@ -21,10 +21,16 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
   const bool default_patch = options_.photo.half_patch == 2;
   // Buffers for the whole block: no allocation per vertex.
   std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half));
+  const auto visible_of = [&](std::uint32_t v) {
+    return std::span<const std::uint16_t>(fields.visible_views.data() + v * fields.view_capacity,
+                                          fields.visible_count[v]);
+  };
+  const auto position = [&](std::uint32_t v) { return to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))); };
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
-    const std::span<const std::uint16_t> visible(fields.visible_views.data() + v * fields.view_capacity,
-                                                 fields.visible_count[v]);
-    const Eigen::Vector3d X = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+    const std::span<const std::uint16_t> visible = visible_of(v);
+    const Eigen::Vector3d X = position(v);
+    // The next vertex's image blocks travel to the cache while this vertex's 61 samples run.
+    if (v + 1 < vertices.end && default_patch) detail::prefetch_patches(position(v + 1), visible_of(v + 1), views);
     std::uint8_t& defined = fields.defined[v];
     defined &= static_cast<std::uint8_t>(~(kPhotoDefined | kGradientDefined));
     fields.photo_consistency[v] = 0.0;

@@ -67,6 +67,23 @@ void photo_consistency_5x5_axes(const Eigen::Vector3d& X, double spacing, int ha
   evaluate_5x5_axes(X, spacing, half, view_ids, views, samples);
 }
 
+void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
+                      const std::vector<PhotoView>& views) {
+  for (const std::uint16_t id : view_ids) {
+    const PhotoView& view = views[id];
+    if (!view.pinhole) continue;
+    const Eigen::Vector3d x = view.projection.leftCols<3>() * X + view.projection.col(3);
+    const double u = x.x() / x.z(), v = x.y() / x.z();
+    if (!(x.z() > 0) || !view.patch_inside(u, v, 2)) continue;
+    const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
+    const float* row = view.image->data() + (static_cast<std::size_t>(v) - 2) * stride + (static_cast<std::size_t>(u) - 2) * 3;
+    for (int r = 0; r < 6; ++r, row += stride) {  // 18 floats = 72 bytes: at most two cache lines
+      __builtin_prefetch(row);
+      __builtin_prefetch(row + 17);
+    }
+  }
+}
+
 std::vector<PhotoKernelBuild> photo_kernel_builds() {
   std::vector<PhotoKernelBuild> builds{
       {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_axes}};

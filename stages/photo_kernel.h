@@ -27,6 +27,11 @@ void photo_consistency_5x5_axes(const Eigen::Vector3d& X, double spacing, int ha
                                 std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
                                 std::span<PhotoValue> samples);
 
+//! Starts loading into the cache the image blocks the patches around \p X read in the views
+//! \p view_ids (pinhole views), so that a later evaluation near X does not wait for memory.
+void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
+                      const std::vector<PhotoView>& views);
+
 //! One build of the kernels, for tests that check that the builds agree bit for bit.
 struct PhotoKernelBuild {
   const char* name;  //!< "baseline", "avx2" or "avx512"
