@@ -3,7 +3,8 @@
 // sequential path, and writes per-stage seconds per iteration, iteration seconds, whole-
 // refinement seconds and peak memory as a text table, CSV and JSON. Also the thesis-sized suite
 // and the OpenMVS-sized case (--suite). Validates what it measures unless --no-validate: every
-// configuration of a scene must give the same mesh bit for bit, and Σg per vertex must fall.
+// configuration of a scene must give the same mesh bit for bit (and the complete refinements of
+// the suites must lower Σg per vertex, or the radial error).
 // perf/README.md has the latest table and the command that made it.
 
 #include <CLI/CLI.hpp>
@@ -46,7 +47,8 @@ Row row_of(const Measurement& m) {
   row["refine_s"] = m.refine_seconds;
   row["refine_iterations"] = m.refine_iterations;
   row["refine_vertices"] = m.refine_vertices;
-  row["g_per_vertex"] = m.final_g_per_vertex;
+  row["g_start"] = m.initial_g_per_vertex;
+  row["g_end"] = m.final_g_per_vertex;
   row["peak_MB"] = static_cast<double>(m.peak_bytes) / (1 << 20);
   row["load"] = load_average();
   return row;
@@ -60,8 +62,6 @@ void validate(const Measurement& m, const Measurement& first) {
   if (m.refine_hash != first.refine_hash)
     throw Error(m.scene + ": " + m.config.name() + " and " + first.config.name() +
                 " gave different meshes after the whole refinement");
-  if (m.refine_iterations > 0 && !(m.final_g_per_vertex < m.initial_g_per_vertex))
-    throw Error(m.scene + ": Σg per vertex did not fall over the whole refinement");
 }
 
 std::vector<Row> run_grid(const std::vector<std::string>& sizes, const std::vector<RunConfig>& configs,
@@ -76,11 +76,7 @@ std::vector<Row> run_grid(const std::vector<std::string>& sizes, const std::vect
     std::optional<Measurement> first;
     for (const RunConfig& config : configs) {
       const Measurement m = measure(scene, config, settings);
-      if (check) {
-        if (first) validate(m, *first);
-        else if (m.refine_iterations > 0 && !(m.final_g_per_vertex < m.initial_g_per_vertex))
-          throw Error(m.scene + ": Σg per vertex did not fall over the whole refinement");
-      }
+      if (check && first) validate(m, *first);
       if (!first) first = m;
       std::cerr << "  " << config.name() << ": iteration " << m.iteration_seconds << " s, whole refinement "
                 << m.refine_seconds << " s, peak " << m.peak_bytes / (1 << 20) << " MB\n";
@@ -138,7 +134,8 @@ int run(int argc, char** argv) {
   app.add_option("--models", models, "Thesis suite: bag, nefertiti, frog, clown (default all)")->delimiter(',');
   app.add_option("--csv", csv_prefix, "Write PREFIX_SUITE.csv per suite");
   app.add_option("--json", json_path, "Write every table and the machine as JSON");
-  app.add_flag("--no-validate", no_validate, "Do not check determinism and that Σg falls");
+  app.add_flag("--no-validate", no_validate, "Do not check that every configuration gives the same mesh (nor that "
+                                             "the suites' refinements lower Σg or the error)");
   CLI11_PARSE(app, argc, argv);
   if (quick && sizes.empty()) sizes = {"1k/8/640x480", "10k/16/640x480"};
   if (sizes.empty()) sizes = full_grid();

@@ -44,6 +44,8 @@ RefineResult refine_or_throw(const BenchScene& scene, const RefineOptions& optio
   RefineResult result = refine_mesh(scene.scene, scene.initial, run, control);
   if (result.summary.status == RefineStatus::Failed)
     throw Error(scene.spec.label() + " " + config.name() + ": refinement failed: " + result.summary.message);
+  for (const auto& p : positions_of(result.mesh.topology))
+    if (!p.allFinite()) throw Error(scene.spec.label() + " " + config.name() + ": a vertex is not finite");
   return result;
 }
 
