@@ -20,7 +20,7 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
   const int half = options_.savitzky_golay.half_window();
   const bool default_patch = options_.photo.half_patch == 2;
   // Buffers for the whole block: no allocation per vertex.
-  std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half));
+  std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
   const auto visible_of = [&](std::uint32_t v) {
     return std::span<const std::uint16_t>(fields.visible_views.data() + v * fields.view_capacity,
                                           fields.visible_count[v]);
@@ -36,17 +36,14 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     fields.photo_consistency[v] = 0.0;
     fields.photo_gradient[v].setZero();
 
-    const PhotoValue centre = photo_consistency(X, visible, views, options_.photo);
-    if (!centre.defined()) continue;
-    fields.photo_consistency[v] = centre.g;
-    defined |= kPhotoDefined;
-
-    // samples[axis·2·half + i]: s = −half..−1, 1..half (the centre is shared by the axes).
+    // samples[0] = g(X); samples[1 + axis·2·half + i]: s = −half..−1, 1..half (the centre is
+    // shared by the axes).
     if (default_patch) {
-      detail::photo_consistency_5x5_axes(X, sample_spacing, half, visible, views, samples);
+      detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
     } else {
-      std::size_t k = 0;
-      for (int axis = 0; axis < 3; ++axis)
+      samples[0] = photo_consistency(X, visible, views, options_.photo);
+      std::size_t k = 1;
+      for (int axis = 0; axis < 3 && samples[0].defined(); ++axis)
         for (int s = -half; s <= half; ++s) {
           if (s == 0) continue;
           Eigen::Vector3d sample = X;
@@ -54,10 +51,15 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
           samples[k++] = photo_consistency(sample, visible, views, options_.photo);
         }
     }
+    const PhotoValue centre = samples[0];
+    if (!centre.defined()) continue;
+    fields.photo_consistency[v] = centre.g;
+    defined |= kPhotoDefined;
+
     Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
     bool complete = true;
     for (int axis = 0; axis < 3 && complete; ++axis) {
-      const PhotoValue* line = samples.data() + static_cast<std::size_t>(axis) * 2 * half;
+      const PhotoValue* line = samples.data() + 1 + static_cast<std::size_t>(axis) * 2 * half;
       double derivative = 0.0;
       for (int s = -half; s <= half && complete; ++s) {
         const double c = coefficients_[static_cast<std::size_t>(s + half)];

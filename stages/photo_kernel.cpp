@@ -45,10 +45,10 @@ namespace avx512 {
       const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views) { \
     return build::photo_consistency_5x5(X, view_ids, views);                                              \
   }                                                                                                       \
-  __attribute__((target(target_name))) void evaluate_5x5_axes(                                            \
+  __attribute__((target(target_name))) void evaluate_5x5_samples(                                            \
       const Eigen::Vector3d& X, double spacing, int half, std::span<const std::uint16_t> view_ids,        \
       const std::vector<PhotoView>& views, std::span<PhotoValue> samples) {                               \
-    build::photo_consistency_5x5_axes(X, spacing, half, view_ids, views, samples);                        \
+    build::photo_consistency_5x5_samples(X, spacing, half, view_ids, views, samples);                        \
   }
 MVFLOW_VERSIONED("default", baseline)
 MVFLOW_VERSIONED("avx2", avx2)
@@ -60,11 +60,11 @@ PhotoValue photo_consistency_5x5(const Eigen::Vector3d& X, std::span<const std::
   return evaluate_5x5(X, view_ids, views);
 }
 
-void photo_consistency_5x5_axes(const Eigen::Vector3d& X, double spacing, int half,
+void photo_consistency_5x5_samples(const Eigen::Vector3d& X, double spacing, int half,
                                 std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
                                 std::span<PhotoValue> samples) {
-  MVFLOW_CHECK(samples.size() >= static_cast<std::size_t>(6 * half), "photo_consistency_5x5_axes: too few samples");
-  evaluate_5x5_axes(X, spacing, half, view_ids, views, samples);
+  MVFLOW_CHECK(samples.size() >= static_cast<std::size_t>(6 * half + 1), "photo_consistency_5x5_samples: too few samples");
+  evaluate_5x5_samples(X, spacing, half, view_ids, views, samples);
 }
 
 void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
@@ -86,12 +86,12 @@ void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> v
 
 std::vector<PhotoKernelBuild> photo_kernel_builds() {
   std::vector<PhotoKernelBuild> builds{
-      {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_axes}};
+      {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_samples}};
   if (__builtin_cpu_supports("avx2"))
-    builds.push_back({"avx2", &avx2::photo_consistency_5x5, &avx2::photo_consistency_5x5_axes});
+    builds.push_back({"avx2", &avx2::photo_consistency_5x5, &avx2::photo_consistency_5x5_samples});
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
       __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512cd"))
-    builds.push_back({"avx512", &avx512::photo_consistency_5x5, &avx512::photo_consistency_5x5_axes});
+    builds.push_back({"avx512", &avx512::photo_consistency_5x5, &avx512::photo_consistency_5x5_samples});
   return builds;
 }
 

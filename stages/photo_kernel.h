@@ -20,12 +20,14 @@ namespace mvflow::detail {
 PhotoValue photo_consistency_5x5(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                                  const std::vector<PhotoView>& views);
 
-//! g at X + s·spacing·e_a for a = x, y, z and s = −half..−1, 1..half (in that order,
-//! 6·half values into \p samples), over the views \p view_ids, 5×5 patch. For pinhole views the
-//! projection of the samples is P·X + s·spacing·P_a (linear in s), evaluated for 8 views at once.
-void photo_consistency_5x5_axes(const Eigen::Vector3d& X, double spacing, int half,
-                                std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
-                                std::span<PhotoValue> samples);
+//! The 3k+1 samples of the gradient stage with the 5×5 patch, over the views \p view_ids:
+//! samples[0] = g(X) (the same bits as photo_consistency_5x5), then g(X + s·spacing·e_a) for
+//! a = x, y, z and s = −half..−1, 1..half (6·half values). When g(X) is undefined, only
+//! samples[0] is written. For pinhole views the projection of the samples is P·X + s·spacing·P_a
+//! (linear in s), evaluated for 8 views at once.
+void photo_consistency_5x5_samples(const Eigen::Vector3d& X, double spacing, int half,
+                                   std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
+                                   std::span<PhotoValue> samples);
 
 //! Starts loading into the cache the image blocks the patches around \p X read in the views
 //! \p view_ids (pinhole views), so that a later evaluation near X does not wait for memory.
@@ -36,8 +38,8 @@ void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> v
 struct PhotoKernelBuild {
   const char* name;  //!< "baseline", "avx2" or "avx512"
   PhotoValue (*consistency)(const Eigen::Vector3d&, std::span<const std::uint16_t>, const std::vector<PhotoView>&);
-  void (*axes)(const Eigen::Vector3d&, double, int, std::span<const std::uint16_t>, const std::vector<PhotoView>&,
-               std::span<PhotoValue>);
+  void (*samples)(const Eigen::Vector3d&, double, int, std::span<const std::uint16_t>, const std::vector<PhotoView>&,
+                  std::span<PhotoValue>);
 };
 //! The builds this CPU can run, baseline first.
 std::vector<PhotoKernelBuild> photo_kernel_builds();
