@@ -75,11 +75,13 @@ void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> v
     const Eigen::Vector3d x = view.projection.leftCols<3>() * X + view.projection.col(3);
     const double u = x.x() / x.z(), v = x.y() / x.z();
     if (!(x.z() > 0) || !view.patch_inside(u, v, 2)) continue;
+    // The 6×6 block and a margin of 2 pixels on every side, where nearby samples read.
+    const int x_first = std::max(static_cast<int>(u) - 4, 0), x_last = std::min(static_cast<int>(u) + 5, view.width - 1);
+    const int y_first = std::max(static_cast<int>(v) - 4, 0), y_last = std::min(static_cast<int>(v) + 5, view.height - 1);
     const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
-    const float* row = view.image->data() + (static_cast<std::size_t>(v) - 2) * stride + (static_cast<std::size_t>(u) - 2) * 3;
-    for (int r = 0; r < 6; ++r, row += stride) {  // 18 floats = 72 bytes: at most two cache lines
-      __builtin_prefetch(row);
-      __builtin_prefetch(row + 17);
+    for (int y = y_first; y <= y_last; ++y) {
+      const float* row = view.image->data() + static_cast<std::size_t>(y) * stride;
+      for (int x = x_first; x <= x_last + 5; x += 5) __builtin_prefetch(row + std::min(x, x_last) * 3);  // 60 bytes apart
     }
   }
 }
