@@ -1,6 +1,7 @@
 #include "engine/refiner.h"
 
 #include <oneapi/tbb/info.h>
+#include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
@@ -62,33 +63,38 @@ struct SurfaceState {
 SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>& views, const RefineOptions& options) {
   VertexFields fields;
   fields.resize(mesh.n_vertices(), views.size());
-  const IndexRange all{0, static_cast<std::uint32_t>(mesh.n_vertices())};
-  compute_normals(mesh, all, fields);
   const SurfaceQuery surface(mesh);
-  compute_visibility(mesh, all, views, surface, edge_lengths(mesh).mean, options.visibility, fields);
-  compute_photo_consistency(mesh, all, views, options.photo.photo, fields);
+  const double mean_edge = edge_lengths(mesh).mean;
   SurfaceState state;
   state.g.resize(mesh.n_vertices(), 0.0f);
   state.colours.resize(mesh.n_vertices(), Eigen::Vector3f::Zero());
+  // Per vertex block in parallel: every vertex's values depend on that vertex alone.
+  const std::vector<IndexRange> blocks = split_into_blocks(mesh.n_vertices(), options.block_size);
+  oneapi::tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+    const IndexRange block = blocks[b];
+    compute_normals(mesh, block, fields);
+    compute_visibility(mesh, block, views, surface, mean_edge, options.visibility, fields);
+    compute_photo_consistency(mesh, block, views, options.photo.photo, fields);
+    for (std::uint32_t v = block.begin; v < block.end; ++v) {
+      const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+      Eigen::Vector3d colour = Eigen::Vector3d::Zero();
+      for (std::uint16_t k = 0; k < fields.visible_count[v]; ++k) {
+        const PhotoView& view = views[fields.visible_views[v * fields.view_capacity + k]];
+        const Projection p = view.project(P);
+        colour += view.image->sample_bilinear(p.u, p.v).cast<double>();
+      }
+      if (fields.visible_count[v] > 0) state.colours[v] = (colour / fields.visible_count[v]).cast<float>();
+    }
+  });
+  // Σg in id order, whatever the blocks.
   double sum = 0.0;
   std::size_t defined = 0;
-  for (std::uint32_t v = 0; v < mesh.n_vertices(); ++v) {
+  for (std::uint32_t v = 0; v < mesh.n_vertices(); ++v)
     if (fields.defined[v] & kPhotoDefined) {
       state.g[v] = static_cast<float>(fields.photo_consistency[v]);
       sum += fields.photo_consistency[v];
       ++defined;
     }
-    const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
-    Eigen::Vector3d colour = Eigen::Vector3d::Zero();
-    int seen = 0;
-    for (std::uint16_t k = 0; k < fields.visible_count[v]; ++k) {
-      const PhotoView& view = views[fields.visible_views[v * fields.view_capacity + k]];
-      const Projection p = view.project(P);
-      colour += view.image->sample_bilinear(p.u, p.v).cast<double>();
-      ++seen;
-    }
-    if (seen > 0) state.colours[v] = (colour / seen).cast<float>();
-  }
   state.sum_g_per_vertex = defined ? sum / static_cast<double>(defined) : 0.0;
   return state;
 }

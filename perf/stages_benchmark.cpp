@@ -1,142 +1,291 @@
-// Throughput of each stage on a rendered scene (the default synth scene's bumpy sphere, 16
-// views of 640×480), and of a whole iteration with the flow graph and the sequential path.
-// Items are vertices unless a label says otherwise.
+// Throughput of each stage of an iteration on a rendered scene (the bumpy sphere, a 10k-vertex
+// initial mesh, 16 views of 640×480), of a whole iteration with the flow graph and the
+// sequential path, of the graph alone (empty node bodies), and the read bound of the photo
+// kernel (the same patch reads with nothing else to do). Items are vertices unless a label or
+// counter says otherwise. Build Release; perf/README.md has the latest numbers.
 
 #include <benchmark/benchmark.h>
 
 #include <oneapi/tbb/task_arena.h>
 
-#include <random>
+#include <atomic>
+#include <cmath>
+#include <numbers>
 
 #include "engine/iteration.h"
 #include "engine/iteration_graph.h"
+#include "engine/mesh_stats.h"
 #include "engine/surface_query.h"
+#include "perf/bench_scene.h"
+#include "perf/patch_gather.h"
+#include "stages/adaptive_refinement.h"
+#include "stages/commit.h"
 #include "stages/curvature.h"
 #include "stages/normals.h"
 #include "stages/photo_consistency.h"
 #include "stages/photo_gradient.h"
+#include "stages/regularization.h"
 #include "stages/smoothing.h"
-#include "stages/synth_scene.h"
+#include "stages/speed.h"
 #include "stages/visibility.h"
 
 namespace mvflow {
 namespace {
 
-struct BenchScene {
-  SynthScene synth;
-  std::vector<Camera> cameras;
+struct StageScene {
+  perf::BenchScene bench;
   std::vector<PhotoView> views;
-  Mesh mesh;  // the initial mesh
   double mean_edge = 0, shortest_edge = 0;
+  const TriMesh& mesh() const { return bench.initial.topology; }
+  IndexRange everything() const { return {0, static_cast<std::uint32_t>(bench.initial.n_vertices())}; }
+  std::size_t n_vertices() const { return bench.initial.n_vertices(); }
 };
 
-const BenchScene& scene() {
-  static const BenchScene cached = [] {
-    BenchScene s;
-    SynthOptions options;
-    options.init.vertices = 10000;
-    BuiltinShapeOptions shape;
-    shape.level = 6;
-    s.synth = make_synth_scene(make_builtin_object("bumpy-sphere", shape), nullptr, options);
-    for (const auto& v : s.synth.views) s.cameras.push_back(v.camera);
-    std::vector<const Image*> images;
-    for (const auto& image : s.synth.images) images.push_back(&image);
-    s.views = make_photo_views(s.cameras, images);
-    s.mesh = build_mesh(s.synth.initial, "initial");
-    s.shortest_edge = 1e300;
-    for (auto e : s.mesh.topology.edges()) {
-      s.mean_edge += s.mesh.topology.calc_edge_length(e);
-      s.shortest_edge = std::min(s.shortest_edge, s.mesh.topology.calc_edge_length(e));
-    }
-    s.mean_edge /= static_cast<double>(s.mesh.topology.n_edges());
+const StageScene& scene() {
+  static const StageScene cached = [] {
+    StageScene s;
+    s.bench = perf::make_bench_scene(perf::SceneSpec::parse("10k/16/640x480"));
+    s.views = make_photo_views(s.bench.scene);
+    const EdgeLengths edges = edge_lengths(s.mesh());
+    s.mean_edge = edges.mean;
+    s.shortest_edge = edges.shortest;
     return s;
   }();
   return cached;
 }
 
-IndexRange everything(const Mesh& mesh) { return {0, static_cast<std::uint32_t>(mesh.n_vertices())}; }
-
-VertexFields visible_fields() {
-  const BenchScene& s = scene();
-  VertexFields fields;
-  fields.resize(s.mesh.n_vertices(), s.views.size());
-  compute_normals(s.mesh.topology, everything(s.mesh), fields);
-  const SurfaceQuery surface(s.mesh.topology);
-  compute_visibility(s.mesh.topology, everything(s.mesh), s.views, surface, s.mean_edge, {}, fields);
-  return fields;
+// Normals, curvature and visibility of the initial mesh: the inputs of the photo stages.
+const VertexFields& visible_fields() {
+  static const VertexFields cached = [] {
+    const StageScene& s = scene();
+    VertexFields fields;
+    fields.resize(s.n_vertices(), s.views.size());
+    compute_normals(s.mesh(), s.everything(), fields);
+    compute_mean_curvature(s.mesh(), s.everything(), fields);
+    const SurfaceQuery surface(s.mesh());
+    compute_visibility(s.mesh(), s.everything(), s.views, surface, s.mean_edge, {}, fields);
+    return fields;
+  }();
+  return cached;
 }
 
+std::span<const std::uint16_t> visible_of(const VertexFields& fields, std::size_t v) {
+  return {fields.visible_views.data() + v * fields.view_capacity, fields.visible_count[v]};
+}
+
+double sample_spacing() { return PhotoGradientStage().sample_spacing(scene().shortest_edge); }
+
+// The patch reads of the gradient stage (centre + 60 axis samples, usable views only).
+const std::vector<perf::PatchBlock>& gradient_blocks() {
+  static const std::vector<perf::PatchBlock> cached = [] {
+    const StageScene& s = scene();
+    const VertexFields& fields = visible_fields();
+    std::vector<Eigen::Vector3d> points(s.n_vertices());
+    std::vector<std::vector<std::uint16_t>> visible(s.n_vertices());
+    for (std::size_t v = 0; v < s.n_vertices(); ++v) {
+      points[v] = s.bench.initial.position(v);
+      const auto ids = visible_of(fields, v);
+      visible[v].assign(ids.begin(), ids.end());
+      // The stage samples the axes only where g is defined at the vertex itself.
+      if (!photo_consistency(points[v], ids, s.views).defined()) visible[v].clear();
+    }
+    return perf::gradient_patch_blocks(points, visible, s.views, sample_spacing(), PhotoGradientStage().options().savitzky_golay.half_window());
+  }();
+  return cached;
+}
+
+constexpr double kPixelsPerPatch = 36;  // the 6×6-pixel bilinear support of a 5×5 patch
+
 void BM_NormalsAndCurvature(benchmark::State& state) {
-  const BenchScene& s = scene();
+  const StageScene& s = scene();
   VertexFields fields;
-  fields.resize(s.mesh.n_vertices(), 0);
+  fields.resize(s.n_vertices(), 0);
   for (auto _ : state) {
-    compute_normals(s.mesh.topology, everything(s.mesh), fields);
-    compute_mean_curvature(s.mesh.topology, everything(s.mesh), fields);
+    compute_normals(s.mesh(), s.everything(), fields);
+    compute_mean_curvature(s.mesh(), s.everything(), fields);
   }
-  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.mesh.n_vertices()));
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
 }
 BENCHMARK(BM_NormalsAndCurvature)->Unit(benchmark::kMillisecond);
 
 void BM_Visibility(benchmark::State& state) {
-  const BenchScene& s = scene();
+  const StageScene& s = scene();
   VertexFields fields;
-  fields.resize(s.mesh.n_vertices(), s.views.size());
-  compute_normals(s.mesh.topology, everything(s.mesh), fields);
-  const SurfaceQuery surface(s.mesh.topology);
+  fields.resize(s.n_vertices(), s.views.size());
+  compute_normals(s.mesh(), s.everything(), fields);
+  const SurfaceQuery surface(s.mesh());
+  // Occlusion rays: the vertex–view pairs that pass the cheap tests (in front, patch inside the
+  // image, not grazing) and so reach Embree.
+  const double cos_max = std::cos(VisibilityOptions{}.max_angle_degrees * std::numbers::pi / 180.0);
+  int64_t rays = 0;
+  for (std::size_t v = 0; v < s.n_vertices(); ++v) {
+    if (!(fields.defined[v] & kNormalDefined)) continue;
+    const Eigen::Vector3d P = s.bench.initial.position(v);
+    for (const PhotoView& view : s.views) {
+      const Projection p = view.project(P);
+      const Eigen::Vector3d to_camera = view.camera->centre() - P;
+      rays += p.depth > 0 && view.patch_inside(p.u, p.v, 2) &&
+              fields.normal[v].dot(to_camera) > cos_max * to_camera.norm();
+    }
+  }
   for (auto _ : state)
-    compute_visibility(s.mesh.topology, everything(s.mesh), s.views, surface, s.mean_edge, {}, fields);
-  // Items: candidate vertex–view pairs (at most one occlusion ray each).
-  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.mesh.n_vertices() * s.views.size()));
-  state.SetLabel("items = vertex-view pairs");
+    compute_visibility(s.mesh(), s.everything(), s.views, surface, s.mean_edge, {}, fields);
+  state.SetItemsProcessed(state.iterations() * rays);
+  state.SetLabel("items = occlusion rays");
 }
 BENCHMARK(BM_Visibility)->Unit(benchmark::kMillisecond);
 
 void BM_PhotoConsistency(benchmark::State& state) {
-  const BenchScene& s = scene();
+  const StageScene& s = scene();
   VertexFields fields = visible_fields();
-  std::size_t view_samples = 0;
-  for (auto count : fields.visible_count) view_samples += count;
-  for (auto _ : state) compute_photo_consistency(s.mesh.topology, everything(s.mesh), s.views, {}, fields);
-  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.mesh.n_vertices()));
-  // Patch-pixel reads: 36 pixels (6×6 bilinear support) × 3 channels per view sample.
+  double view_samples = 0;
+  for (std::size_t v = 0; v < s.n_vertices(); ++v)
+    view_samples += photo_consistency(s.bench.initial.position(v), visible_of(fields, v), s.views).views;
+  for (auto _ : state) compute_photo_consistency(s.mesh(), s.everything(), s.views, {}, fields);
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
   state.counters["patch_pixel_reads/s"] =
-      benchmark::Counter(static_cast<double>(view_samples) * 36 * state.iterations(), benchmark::Counter::kIsRate);
+      benchmark::Counter(view_samples * kPixelsPerPatch * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.SetLabel("items = evaluations of g");
 }
 BENCHMARK(BM_PhotoConsistency)->Unit(benchmark::kMillisecond);
 
 void BM_PhotoGradient(benchmark::State& state) {
-  const BenchScene& s = scene();
+  const StageScene& s = scene();
   VertexFields fields = visible_fields();
   const PhotoGradientStage stage;
-  for (auto _ : state) stage.run(s.mesh.topology, everything(s.mesh), s.views, stage.sample_spacing(s.shortest_edge), fields);
-  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.mesh.n_vertices()));
+  const double evaluations = 3.0 * stage.options().savitzky_golay.k + 1;
+  const double view_samples = static_cast<double>(gradient_blocks().size());
+  for (auto _ : state) stage.run(s.mesh(), s.everything(), s.views, sample_spacing(), fields);
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
+  const double runs = static_cast<double>(state.iterations());
+  state.counters["g_evaluations/s"] =
+      benchmark::Counter(evaluations * static_cast<double>(s.n_vertices()) * runs, benchmark::Counter::kIsRate);
+  state.counters["patch_pixel_reads/s"] =
+      benchmark::Counter(view_samples * kPixelsPerPatch * runs, benchmark::Counter::kIsRate);
   state.SetLabel("61 evaluations of g per vertex");
 }
 BENCHMARK(BM_PhotoGradient)->Unit(benchmark::kMillisecond);
 
+// The bound for BM_PhotoGradient's patch_pixel_reads/s: its reads without its arithmetic.
+void BM_PatchGatherBound(benchmark::State& state) {
+  const auto& blocks = gradient_blocks();
+  for (auto _ : state) benchmark::DoNotOptimize(perf::gather_patch_blocks(blocks));
+  state.counters["patch_pixel_reads/s"] = benchmark::Counter(
+      static_cast<double>(blocks.size()) * kPixelsPerPatch * static_cast<double>(state.iterations()),
+      benchmark::Counter::kIsRate);
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(blocks.size()));
+  state.SetLabel("items = 6x6-pixel blocks of the gradient's samples");
+}
+BENCHMARK(BM_PatchGatherBound)->Unit(benchmark::kMillisecond);
+
+// The serial reduction node: partials, Σg in id order, the quantile and median of |F|, Δt.
+void BM_CflReduction(benchmark::State& state) {
+  const StageScene& s = scene();
+  TriMesh mesh = s.mesh();
+  const RefineOptions options;
+  IterationData data(mesh, s.views, options, nullptr);
+  data.reset_topology();
+  data.fields = visible_fields();
+  data.shortest_edge = s.shortest_edge;
+  data.mean_edge = s.mean_edge;
+  data.sample_spacing = sample_spacing();
+  for (std::size_t b = 0; b < data.blocks.size(); ++b) data.photo_speed(b);
+  for (auto _ : state) data.cfl();
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
+}
+BENCHMARK(BM_CflReduction)->Unit(benchmark::kMillisecond);
+
+// Move, smoothing and regularization (each with its commit) as one iteration runs them.
+void BM_MoveSmoothRegularize(benchmark::State& state) {
+  const StageScene& s = scene();
+  TriMesh mesh = s.mesh();
+  const RefineOptions options;
+  IterationData data(mesh, s.views, options, nullptr);
+  data.reset_topology();
+  data.fields = visible_fields();
+  data.shortest_edge = s.shortest_edge;
+  data.mean_edge = s.mean_edge;
+  data.sample_spacing = sample_spacing();
+  for (std::size_t b = 0; b < data.blocks.size(); ++b) {
+    data.geometry(b);
+    data.photo_speed(b);
+  }
+  data.cfl();
+  const std::size_t n = data.blocks.size();
+  for (auto _ : state) {
+    state.PauseTiming();
+    mesh = s.mesh();
+    state.ResumeTiming();
+    for (std::size_t b = 0; b < n; ++b) data.move(b);
+    for (std::size_t b = 0; b < n; ++b) data.smooth(b);
+    for (std::size_t b = 0; b < n; ++b) data.commit(b);
+    for (std::size_t b = 0; b < n; ++b) data.regularize(b);
+    for (std::size_t b = 0; b < n; ++b) data.commit(b);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
+}
+BENCHMARK(BM_MoveSmoothRegularize)->Unit(benchmark::kMillisecond);
+
 void BM_Smoothing(benchmark::State& state) {
-  const BenchScene& s = scene();
-  std::vector<Eigen::Vector3d> buffer(s.mesh.n_vertices());
-  for (auto _ : state) smooth_curvature_normal(s.mesh.topology, everything(s.mesh), SmoothingOptions{}, buffer);
-  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.mesh.n_vertices()));
+  const StageScene& s = scene();
+  std::vector<Eigen::Vector3d> buffer(s.n_vertices());
+  for (auto _ : state) smooth_curvature_normal(s.mesh(), s.everything(), SmoothingOptions{}, buffer);
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
 }
 BENCHMARK(BM_Smoothing)->Unit(benchmark::kMillisecond);
 
+void BM_Regularization(benchmark::State& state) {
+  const StageScene& s = scene();
+  const VertexFields& fields = visible_fields();
+  std::vector<Eigen::Vector3d> buffer(s.n_vertices());
+  for (auto _ : state) regularize_tangential(s.mesh(), s.everything(), fields, RegularizationOptions{}, buffer);
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
+}
+BENCHMARK(BM_Regularization)->Unit(benchmark::kMillisecond);
+
+// Adaptive refinement (red–green) of the initial mesh with a threshold that marks about a
+// tenth of the vertices; items are input vertices.
+void BM_AdaptiveRefinement(benchmark::State& state) {
+  const StageScene& s = scene();
+  const VertexFields& fields = visible_fields();
+  std::vector<double> lengths;
+  for (std::size_t v = 0; v < s.n_vertices(); ++v)
+    if (fields.defined[v] & kCurvatureDefined) lengths.push_back(fields.curvature_normal_length[v]);
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() * 9 / 10, lengths.end());
+  AdaptiveRefinementOptions options;
+  options.min_edge_pixels = 0;
+  const double reference_edge = lengths[lengths.size() * 9 / 10] / options.curvature_factor;
+  std::size_t added = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    TriMesh mesh = s.mesh();
+    state.ResumeTiming();
+    added = refine_adaptively(mesh, fields, reference_edge, options).new_vertices;
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
+  state.SetLabel("adds " + std::to_string(added) + " vertices");
+}
+BENCHMARK(BM_AdaptiveRefinement)->Unit(benchmark::kMillisecond);
+
 // One whole iteration: arg 0 = engine (0 graph, 1 sequential), arg 1 = threads.
+// Arg 2 = 1 runs the graph with every node body empty (the kernels return at once when the
+// cancel flag is set): the graph's own cost over the same blocks.
 void BM_Iteration(benchmark::State& state) {
-  const BenchScene& s = scene();
+  const StageScene& s = scene();
   RefineOptions options;
   options.engine = state.range(0) == 0 ? EngineKind::Graph : EngineKind::Sequential;
+  const bool empty_bodies = state.range(2) == 1;
+  std::atomic<bool> skip_bodies{false};
   oneapi::tbb::task_arena arena(static_cast<int>(state.range(1)));
-  TriMesh mesh = s.mesh.topology;
+  TriMesh mesh = s.mesh();
   arena.execute([&] {
-    IterationData data(mesh, s.views, options, nullptr);
+    IterationData data(mesh, s.views, options, &skip_bodies);
     data.reset_topology();
     data.shortest_edge = s.shortest_edge;
     data.mean_edge = s.mean_edge;
-    data.sample_spacing = data.photo.sample_spacing(s.shortest_edge);
+    data.sample_spacing = sample_spacing();
     IterationGraph graph(data);
+    skip_bodies = empty_bodies;
     for (auto _ : state) {
       if (options.engine == EngineKind::Graph)
         graph.run();
@@ -144,11 +293,17 @@ void BM_Iteration(benchmark::State& state) {
         run_iteration_sequential(data);
     }
   });
-  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.mesh.n_vertices()));
-  state.SetLabel(std::string(state.range(0) == 0 ? "graph" : "sequential") + ", " + std::to_string(state.range(1)) +
-                 " thread(s)");
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
+  state.SetLabel(std::string(empty_bodies ? "graph, empty bodies" : state.range(0) == 0 ? "graph" : "sequential") +
+                 ", " + std::to_string(state.range(1)) + " thread(s)");
 }
-BENCHMARK(BM_Iteration)->Args({0, 1})->Args({0, 2})->Args({1, 1})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Iteration)
+    ->Args({0, 1, 0})
+    ->Args({0, 2, 0})
+    ->Args({1, 1, 0})
+    ->Args({0, 2, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace mvflow

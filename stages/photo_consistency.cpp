@@ -1,9 +1,11 @@
 #include "stages/photo_consistency.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
 #include "engine/error.h"
+#include "stages/photo_kernel.h"
 
 namespace mvflow {
 
@@ -12,16 +14,20 @@ namespace {
 constexpr int kMaxSide = 15;  // 2·7 + 1
 constexpr int kMaxValues = 3 * kMaxSide * kMaxSide;
 
-}  // namespace
-
-PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
-                             const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options) {
-  const int h = options.half_patch;
+// g for any patch size (the default 5×5 has its own kernel, stages/photo_kernel.h) with the same
+// arithmetic: each value interpolated in float, h = a + fx·(b − a) along the row, then
+// C = h + fy·(h' − h) down, and g = (Σ C² − Σ_values (Σ_i C)²/m) / ((m − 1)·side²) from sums in
+// double. A patch row is 3·side contiguous floats, read at two horizontal offsets (0 and 3 = the
+// next pixel): loops the compiler vectorizes.
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
+PhotoValue photo_consistency_any(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
+                                 const std::vector<PhotoView>& views, int h) {
   const int side = 2 * h + 1;
-  const int values = 3 * side * side;
-  // Per (offset, channel): Σ C and Σ C² over the views, in double (SPEC §3).
-  std::array<double, kMaxValues> sum{};
-  std::array<double, kMaxValues> sum_squares{};
+  const int width = 3 * side;
+  const int values = width * side;
+  std::array<double, kMaxValues> sum;  // Σ_i C per value
+  std::fill_n(sum.begin(), values, 0.0);
+  double squares = 0.0;  // Σ_i Σ_values C²
   int used = 0;
   for (const std::uint16_t id : view_ids) {
     const PhotoView& view = views[id];
@@ -30,33 +36,41 @@ PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint
     ++used;
     const int x0 = static_cast<int>(std::floor(p.u));
     const int y0 = static_cast<int>(std::floor(p.v));
-    // One set of bilinear weights serves the whole patch: the offsets are whole pixels.
-    // Weights and sums in double: g is a difference of large sums (SPEC §3).
-    const double fx = p.u - x0, fy = p.v - y0;
-    const double w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
-    const float* data = view.image->data();
+    // One pair of weights serves the whole patch: the offsets are whole pixels.
+    const float fx = static_cast<float>(p.u - x0), fy = static_cast<float>(p.v - y0);
     const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
-    int k = 0;
-    for (int dy = -h; dy <= h; ++dy) {
-      const float* row = data + static_cast<std::size_t>(y0 + dy) * stride + static_cast<std::size_t>(x0 - h) * 3;
-      const float* next = row + stride;
-      for (int dx = 0; dx < side; ++dx, row += 3, next += 3)
-        for (int c = 0; c < 3; ++c, ++k) {
-          const double value = w00 * row[c] + w10 * row[c + 3] + w01 * next[c] + w11 * next[c + 3];
-          sum[k] += value;
-          sum_squares[k] += value * value;
-        }
+    const float* row = view.image->data() + static_cast<std::size_t>(y0 - h) * stride + static_cast<std::size_t>(x0 - h) * 3;
+    std::array<float, 3 * kMaxSide> top, bottom;
+    for (int j = 0; j < width; ++j) top[j] = row[j] + fx * (row[j + 3] - row[j]);
+    for (int r = 0; r < side; ++r) {
+      row += stride;
+      for (int j = 0; j < width; ++j) bottom[j] = row[j] + fx * (row[j + 3] - row[j]);
+      double* __restrict row_sum = sum.data() + r * width;
+      for (int j = 0; j < width; ++j) {
+        const double value = top[j] + fy * (bottom[j] - top[j]);
+        row_sum[j] += value;
+        squares += value * value;
+      }
+      top = bottom;
     }
   }
   PhotoValue result;
   result.views = used;
   if (used < 2) return result;
   const double m = used;
-  double total = 0.0;
-  for (int k = 0; k < values; ++k) total += (sum_squares[k] - sum[k] * sum[k] / m) / (m - 1);
+  double sum_squared = 0.0;
+  for (int k = 0; k < values; ++k) sum_squared += sum[k] * sum[k];
   // Rounding can leave a tiny negative variance where all views agree; g is a variance sum.
-  result.g = std::max(0.0, total / (side * side));
+  result.g = std::max(0.0, (squares - sum_squared / m) / ((m - 1) * (side * side)));
   return result;
+}
+
+}  // namespace
+
+PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
+                             const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options) {
+  if (options.half_patch == 2) return detail::photo_consistency_5x5(X, view_ids, views);
+  return photo_consistency_any(X, view_ids, views, options.half_patch);
 }
 
 void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,

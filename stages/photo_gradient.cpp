@@ -3,6 +3,7 @@
 #include <span>
 
 #include "engine/error.h"
+#include "stages/photo_kernel.h"
 
 namespace mvflow {
 
@@ -17,16 +18,40 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
                              double sample_spacing, VertexFields& fields) const {
   MVFLOW_CHECK(sample_spacing > 0, "photo gradient: sample spacing must be positive");
   const int half = options_.savitzky_golay.half_window();
+  const bool default_patch = options_.photo.half_patch == 2;
+  // Buffers for the whole block: no allocation per vertex.
+  std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
+  const auto visible_of = [&](std::uint32_t v) {
+    return std::span<const std::uint16_t>(fields.visible_views.data() + v * fields.view_capacity,
+                                          fields.visible_count[v]);
+  };
+  const auto position = [&](std::uint32_t v) { return to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))); };
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
-    const std::span<const std::uint16_t> visible(fields.visible_views.data() + v * fields.view_capacity,
-                                                 fields.visible_count[v]);
-    const Eigen::Vector3d X = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+    const std::span<const std::uint16_t> visible = visible_of(v);
+    const Eigen::Vector3d X = position(v);
+    // The next vertex's image blocks travel to the cache while this vertex's 61 samples run.
+    if (v + 1 < vertices.end && default_patch) detail::prefetch_patches(position(v + 1), visible_of(v + 1), views);
     std::uint8_t& defined = fields.defined[v];
     defined &= static_cast<std::uint8_t>(~(kPhotoDefined | kGradientDefined));
     fields.photo_consistency[v] = 0.0;
     fields.photo_gradient[v].setZero();
 
-    const PhotoValue centre = photo_consistency(X, visible, views, options_.photo);
+    // samples[0] = g(X); samples[1 + axis·2·half + i]: s = −half..−1, 1..half (the centre is
+    // shared by the axes).
+    if (default_patch) {
+      detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
+    } else {
+      samples[0] = photo_consistency(X, visible, views, options_.photo);
+      std::size_t k = 1;
+      for (int axis = 0; axis < 3 && samples[0].defined(); ++axis)
+        for (int s = -half; s <= half; ++s) {
+          if (s == 0) continue;
+          Eigen::Vector3d sample = X;
+          sample[axis] += s * sample_spacing;
+          samples[k++] = photo_consistency(sample, visible, views, options_.photo);
+        }
+    }
+    const PhotoValue centre = samples[0];
     if (!centre.defined()) continue;
     fields.photo_consistency[v] = centre.g;
     defined |= kPhotoDefined;
@@ -34,16 +59,15 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
     bool complete = true;
     for (int axis = 0; axis < 3 && complete; ++axis) {
+      const PhotoValue* line = samples.data() + 1 + static_cast<std::size_t>(axis) * 2 * half;
       double derivative = 0.0;
       for (int s = -half; s <= half && complete; ++s) {
         const double c = coefficients_[static_cast<std::size_t>(s + half)];
         if (s == 0) {
-          derivative += c * centre.g;  // the centre sample is shared by the three axes
+          derivative += c * centre.g;
           continue;
         }
-        Eigen::Vector3d sample = X;
-        sample[axis] += s * sample_spacing;
-        const PhotoValue value = photo_consistency(sample, visible, views, options_.photo);
+        const PhotoValue& value = line[s < 0 ? s + half : s + half - 1];
         complete = value.defined();
         derivative += c * value.g;
       }

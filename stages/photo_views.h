@@ -40,7 +40,8 @@ std::vector<PhotoView> make_photo_views(const std::vector<Camera>& cameras, cons
 //! 0 when no view has it in front.
 double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vector3d& point);
 
-//! Views of a scene, decoding its images now. \throw what decoding throws.
+//! Views of a scene, decoding its images now (in parallel, in the current task arena).
+//! \throw what decoding throws.
 std::vector<PhotoView> make_photo_views(const Scene& scene);
 
 }  // namespace mvflow
