@@ -26,11 +26,6 @@ while [ $# -gt 0 ]; do
 done
 refine_options=("$@")
 
-mkdir -p "$out"
-rm -f "$out/scores.tmp"
-step "$out/scene.log" "$mvflow" info "$scene" --json "$out/scene.json"
-views=$(grep -m1 -o '"count": *[0-9]*' "$out/scene.json" | grep -o '[0-9]*$')
-
 # Runs a step, its output in LOG; on failure says which and shows the log's end.
 step() {
   local log=$1
@@ -43,6 +38,11 @@ score() {
   step "$3.log" "$mvflow" heldout "$scene" "$1" --views "$2" --threshold "$threshold" --json "$3"
   awk '$1 == "all" { print $2, $3, $4 }' "$3.log"
 }
+
+mkdir -p "$out"
+rm -f "$out/scores.tmp"
+step "$out/scene.log" "$mvflow" info "$scene" --json "$out/scene.json"
+views=$(grep -m1 -o '"count": *[0-9]*' "$out/scene.json" | grep -o '[0-9]*$')
 
 printf '%-5s %-12s %28s %28s %s\n' fold views "hull: MAE PSNR silhouette" "refined: MAE PSNR silhouette" \
   "refined vertices, Σg/vertex before → after, seconds"
