@@ -1,5 +1,8 @@
 #include "engine/iteration.h"
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -14,6 +17,9 @@
 namespace mvflow {
 
 namespace {
+
+// Vertices per nested task of a photo node (each vertex costs 61 evaluations of g).
+constexpr std::uint32_t kPhotoGrain = 16;
 
 // Adds the wall time of its scope to one stage's slot.
 class StageTimer {
@@ -71,7 +77,17 @@ void IterationData::visibility(std::size_t block) {
 void IterationData::photo_speed(std::size_t block) {
   if (cancelled()) return;
   StageTimer timer(block_seconds[block][static_cast<int>(Stage::PhotoGradient)]);
-  photo.run(mesh, blocks[block], views, sample_spacing, fields);
+  if (options.engine == EngineKind::Graph) {
+    // Idle threads take parts of a long photo node (nested parallelism: the graph is the coarse
+    // level). Every vertex is independent, so the parts do not change any result.
+    const IndexRange range = blocks[block];
+    oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::uint32_t>(range.begin, range.end, kPhotoGrain),
+                              [&](const oneapi::tbb::blocked_range<std::uint32_t>& part) {
+                                photo.run(mesh, {part.begin(), part.end()}, views, sample_spacing, fields);
+                              });
+  } else {
+    photo.run(mesh, blocks[block], views, sample_spacing, fields);
+  }
   compute_speed(blocks[block], options.speed, fields);
   partials[block] = reduce_block(blocks[block], fields);
 }

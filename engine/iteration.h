@@ -70,7 +70,9 @@ struct IterationData {
   void refit();                        //!< serial: Embree refit to the current positions
   void geometry(std::size_t block);    //!< N and H
   void visibility(std::size_t block);  //!< visible views
-  void photo_speed(std::size_t block); //!< g, ∇g (3k+1 samples), F, and the block's partial
+  //! g, ∇g (3k+1 samples), F, and the block's partial; with the graph engine the block's
+  //! vertices are shared among idle threads (nested parallel_for), never with the sequential one.
+  void photo_speed(std::size_t block);
   void cfl();                          //!< serial: combine partials in block order, Δt, median move
   void adapt_step_scale();             //!< part of cfl(): the step control
   void move(std::size_t block);        //!< P ← P + Δt·F

@@ -40,15 +40,15 @@ namespace avx512 {
 // GCC function multiversioning: a resolver picks one build at load time. Callers in other
 // files see only the unversioned functions below (GCC dispatches only where every version is
 // visible).
-#define MVFLOW_VERSIONED(target_name, build)                                                              \
-  __attribute__((target(target_name))) PhotoValue evaluate_5x5(                                           \
+#define MVFLOW_VERSIONED(target_name, build)                                                             \
+  __attribute__((target(target_name))) PhotoValue evaluate_5x5(                                          \
       const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views) { \
-    return build::photo_consistency_5x5(X, view_ids, views);                                              \
-  }                                                                                                       \
-  __attribute__((target(target_name))) void evaluate_5x5_samples(                                            \
-      const Eigen::Vector3d& X, double spacing, int half, std::span<const std::uint16_t> view_ids,        \
-      const std::vector<PhotoView>& views, std::span<PhotoValue> samples) {                               \
-    build::photo_consistency_5x5_samples(X, spacing, half, view_ids, views, samples);                        \
+    return build::photo_consistency_5x5(X, view_ids, views);                                             \
+  }                                                                                                      \
+  __attribute__((target(target_name))) void evaluate_5x5_samples(                                        \
+      const Eigen::Vector3d& X, double spacing, int half, std::span<const std::uint16_t> view_ids,       \
+      const std::vector<PhotoView>& views, std::span<PhotoValue> samples) {                              \
+    build::photo_consistency_5x5_samples(X, spacing, half, view_ids, views, samples);                    \
   }
 MVFLOW_VERSIONED("default", baseline)
 MVFLOW_VERSIONED("avx2", avx2)

@@ -1,9 +1,10 @@
 #pragma once
 // The hot loops of the photo stages for the default 5×5 patch (SPEC §3), in three builds of the
 // same source (x86-64 baseline, AVX2, AVX-512), the fastest one the CPU runs chosen once at load
-// time (GCC function multiversioning). Every build gives the same bits: each value is computed
-// by the same double operations in the same order (no FMA contraction), only the lane width
-// differs. Callers use photo_consistency() and PhotoGradientStage.
+// time (GCC function multiversioning). Every build gives the same bits: each patch value is
+// interpolated by the same float operations and summed by the same double operations in the
+// same order (no FMA contraction); only the lane width differs. Callers use photo_consistency()
+// and PhotoGradientStage.
 
 #include <Eigen/Core>
 #include <cstdint>

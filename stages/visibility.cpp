@@ -23,11 +23,12 @@ void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vec
       const Eigen::Vector3d origin = P + offset * N;
       for (std::size_t i = 0; i < views.size(); ++i) {
         const PhotoView& view = views[i];
-        const Projection p = view.project(P);
-        if (!(p.depth > 0) || !view.patch_inside(p.u, p.v, options.half_patch)) continue;
+        // The cheapest test first (about half the views face away); all must pass.
         const Eigen::Vector3d to_camera = view.camera->centre() - P;
         const double distance = to_camera.norm();
         if (!(N.dot(to_camera) > cos_max * distance)) continue;
+        const Projection p = view.project(P);
+        if (!(p.depth > 0) || !view.patch_inside(p.u, p.v, options.half_patch)) continue;
         const Eigen::Vector3d from_origin = view.camera->centre() - origin;
         if (surface.occluded(origin, from_origin, 0.0, 1.0)) continue;
         visible[count++] = static_cast<std::uint16_t>(i);
