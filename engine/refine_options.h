@@ -62,8 +62,8 @@ struct RefineOptions {
   AdaptiveRefinementOptions adaptive;
   RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration
   //! Vertices per block (one graph node per block and stage). 128: on the default scene (800
-  //! vertices) 2 threads ran 1.76× faster than 1 with 128 and not at all faster with 1024 (one
-  //! block); at 10k vertices 64, 128 and 512 all gave 1.93× (README, "Performance").
+  //! vertices) 1024 left one block and no speed-up from a second thread; at 10k vertices 64, 128
+  //! and 512 gave the same time (README, "Performance").
   std::size_t block_size = 128;
   EngineKind engine = EngineKind::Graph;
   std::vector<int> excluded_views;     //!< 0-based view indices the refinement must not use
