@@ -91,6 +91,8 @@ Camera::Camera(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eigen::
   P_.col(3) = K_ * t_;
 }
 
+double Camera::focal_pixels() const { return std::sqrt(K_(0, 0) * K_(1, 1)); }
+
 Projection Camera::project(const Eigen::Vector3d& X) const {
   const Eigen::Vector3d x = R_ * X + t_;
   Eigen::Vector2d d(x.x() / x.z(), x.y() / x.z());

@@ -62,6 +62,9 @@ class Camera {
   //! Image size in pixels; 0 × 0 while unknown (a Middlebury file before its images are read).
   int width() const { return width_; }
   int height() const { return height_; }
+  //! The focal length in pixels as one number, √(fx·fy): depth / focal_pixels() is the side of
+  //! the square with the area of one pixel at that depth.
+  double focal_pixels() const;
   //! Camera centre C = −Rᵀt in world coordinates.
   const Eigen::Vector3d& centre() const { return centre_; }
   //! The 3×4 matrix K·[R|t] (exact projection only when distortion().is_identity()).

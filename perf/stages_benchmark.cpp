@@ -178,17 +178,22 @@ void BM_PatchGatherBound(benchmark::State& state) {
 }
 BENCHMARK(BM_PatchGatherBound)->Unit(benchmark::kMillisecond);
 
+// What the refiner sets before an iteration runs: blocks and fields sized, the edge lengths and Δx.
+void prepare(IterationData& data, const StageScene& s) {
+  data.reset_topology();
+  data.shortest_edge = s.shortest_edge;
+  data.mean_edge = s.mean_edge;
+  data.sample_spacing = sample_spacing();
+}
+
 // The serial reduction node: partials, Σg in id order, the quantile and median of |F|, Δt.
 void BM_CflReduction(benchmark::State& state) {
   const StageScene& s = scene();
   TriMesh mesh = s.mesh();
   const RefineOptions options;
   IterationData data(mesh, s.views, options, nullptr);
-  data.reset_topology();
+  prepare(data, s);
   data.fields = visible_fields();
-  data.shortest_edge = s.shortest_edge;
-  data.mean_edge = s.mean_edge;
-  data.sample_spacing = sample_spacing();
   for (std::size_t b = 0; b < data.blocks.size(); ++b) data.photo_speed(b);
   for (auto _ : state) data.cfl();
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
@@ -201,11 +206,8 @@ void BM_MoveSmoothRegularize(benchmark::State& state) {
   TriMesh mesh = s.mesh();
   const RefineOptions options;
   IterationData data(mesh, s.views, options, nullptr);
-  data.reset_topology();
+  prepare(data, s);
   data.fields = visible_fields();
-  data.shortest_edge = s.shortest_edge;
-  data.mean_edge = s.mean_edge;
-  data.sample_spacing = sample_spacing();
   for (std::size_t b = 0; b < data.blocks.size(); ++b) {
     data.geometry(b);
     data.photo_speed(b);
@@ -280,10 +282,7 @@ void BM_Iteration(benchmark::State& state) {
   TriMesh mesh = s.mesh();
   arena.execute([&] {
     IterationData data(mesh, s.views, options, &skip_bodies);
-    data.reset_topology();
-    data.shortest_edge = s.shortest_edge;
-    data.mean_edge = s.mean_edge;
-    data.sample_spacing = sample_spacing();
+    prepare(data, s);
     IterationGraph graph(data);
     skip_bodies = empty_bodies;
     for (auto _ : state) {

@@ -25,7 +25,7 @@ double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vecto
   for (const PhotoView& view : views) {
     const Camera& camera = *view.camera;
     const double depth = (camera.R() * point + camera.t()).z();
-    const double focal = 0.5 * (camera.K()(0, 0) + camera.K()(1, 1));
+    const double focal = camera.focal_pixels();
     if (!(depth > 0) || !(focal > 0)) continue;
     const double size = depth / focal;
     if (finest == 0.0 || size < finest) finest = size;

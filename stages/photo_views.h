@@ -36,7 +36,7 @@ struct PhotoView {
 //! Views of \p cameras with \p images (same order and count; both must outlive the result).
 std::vector<PhotoView> make_photo_views(const std::vector<Camera>& cameras, const std::vector<const Image*>& images);
 //! The world length one pixel covers at \p point in the finest of \p views: the smallest
-//! depth/focal over the views that have \p point in front of them (focal = mean of fx and fy).
+//! depth / Camera::focal_pixels() over the views that have \p point in front of them.
 //! 0 when no view has it in front.
 double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vector3d& point);
 

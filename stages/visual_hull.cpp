@@ -131,7 +131,7 @@ ScalarGrid carve_visual_hull(const std::vector<Camera>& cameras, const std::vect
   tbb::parallel_for(std::size_t{0}, silhouettes.size(),
                     [&](std::size_t i) { distances[i] = silhouette_distance(silhouettes[i]); });
   std::vector<double> focal(cameras.size());
-  for (std::size_t i = 0; i < cameras.size(); ++i) focal[i] = std::sqrt(cameras[i].K()(0, 0) * cameras[i].K()(1, 1));
+  for (std::size_t i = 0; i < cameras.size(); ++i) focal[i] = cameras[i].focal_pixels();
 
   ScalarGrid grid;
   const Eigen::Vector3d extent = box.size();

@@ -102,19 +102,30 @@ std::vector<const Image*> pointers(const std::vector<Image>& images) {
   return result;
 }
 
-TEST(PhotoConsistency, EqualsSlowReferenceOnRandomImages) {
-  std::mt19937 random(17);
-  std::uniform_real_distribution<float> value(0, 1);
+// Cameras on an arc of radius 3 around the origin, \p step radians apart at height \p height,
+// looking at it (focal 60, 64×48), each with an image of uniform noise drawn from \p random.
+struct RandomRig {
   std::vector<Camera> cameras;
   std::vector<Image> images;
-  for (int i = 0; i < 5; ++i) {
-    const double a = 0.4 * i;
-    cameras.push_back(look_at({3 * std::sin(a), 0.5, 3 * std::cos(a)}, {0, 0, 0}, 60, 64, 48));
+};
+
+RandomRig random_rig(int count, double step, double height, std::mt19937& random) {
+  std::uniform_real_distribution<float> value(0, 1);
+  RandomRig rig;
+  for (int i = 0; i < count; ++i) {
+    const double a = step * i;
+    rig.cameras.push_back(look_at({3 * std::sin(a), height, 3 * std::cos(a)}, {0, 0, 0}, 60, 64, 48));
     Image image(64, 48);
     for (int y = 0; y < 48; ++y)
       for (int x = 0; x < 64; ++x) image.set_pixel(x, y, {value(random), value(random), value(random)});
-    images.push_back(std::move(image));
+    rig.images.push_back(std::move(image));
   }
+  return rig;
+}
+
+TEST(PhotoConsistency, EqualsSlowReferenceOnRandomImages) {
+  std::mt19937 random(17);
+  const auto [cameras, images] = random_rig(5, 0.4, 0.5, random);
   const auto views = make_photo_views(cameras, pointers(images));
   const std::vector<std::uint16_t> all{0, 1, 2, 3, 4};
   std::uniform_real_distribution<double> coordinate(-0.8, 0.8);
@@ -138,17 +149,7 @@ TEST(PhotoConsistency, EqualsSlowReferenceOnRandomImages) {
 
 TEST(PhotoConsistency, OtherPatchSizesEqualTheSlowReference) {
   std::mt19937 random(23);
-  std::uniform_real_distribution<float> value(0, 1);
-  std::vector<Camera> cameras;
-  std::vector<Image> images;
-  for (int i = 0; i < 4; ++i) {
-    const double a = 0.5 * i;
-    cameras.push_back(look_at({3 * std::sin(a), 0.3, 3 * std::cos(a)}, {0, 0, 0}, 60, 64, 48));
-    Image image(64, 48);
-    for (int y = 0; y < 48; ++y)
-      for (int x = 0; x < 64; ++x) image.set_pixel(x, y, {value(random), value(random), value(random)});
-    images.push_back(std::move(image));
-  }
+  const auto [cameras, images] = random_rig(4, 0.5, 0.3, random);
   const auto views = make_photo_views(cameras, pointers(images));
   const std::vector<std::uint16_t> all{0, 1, 2, 3};
   std::uniform_real_distribution<double> coordinate(-0.6, 0.6);
@@ -172,17 +173,7 @@ TEST(PhotoConsistency, OtherPatchSizesEqualTheSlowReference) {
 TEST(PhotoConsistency, EveryInstructionSetBuildGivesTheSameBits) {
   // The multiversioned 5×5 kernel: baseline, AVX2 and AVX-512 builds on random images and points.
   std::mt19937 random(5);
-  std::uniform_real_distribution<float> value(0, 1);
-  std::vector<Camera> cameras;
-  std::vector<Image> images;
-  for (int i = 0; i < 6; ++i) {
-    const double a = 0.35 * i;
-    cameras.push_back(look_at({3 * std::sin(a), 0.4, 3 * std::cos(a)}, {0, 0, 0}, 60, 64, 48));
-    Image image(64, 48);
-    for (int y = 0; y < 48; ++y)
-      for (int x = 0; x < 64; ++x) image.set_pixel(x, y, {value(random), value(random), value(random)});
-    images.push_back(std::move(image));
-  }
+  const auto [cameras, images] = random_rig(6, 0.35, 0.4, random);
   const auto views = make_photo_views(cameras, pointers(images));
   const std::vector<std::uint16_t> all{0, 1, 2, 3, 4, 5};
   const auto builds = detail::photo_kernel_builds();
