@@ -35,6 +35,7 @@ RefineOptions thesis_preset() {
   options.local_step = false;
   options.step_control = false;
   options.adaptive.min_edge_pixels = 0.0;
+  options.adaptive.min_growth = 0.0;
   options.refinement_schedule = RefinementSchedule::EveryIteration;
   options.stopping.test = ConvergenceTest::EachLookback;
   return options;

@@ -24,6 +24,9 @@ struct IterationReport {
   //! faces added by adaptive refinement: before this iteration (schedule EveryIteration), or
   //! after it when its stop says "refined (…)" (AtConvergence)
   std::size_t refined_faces = 0;
+  //! vertices a refinement would have added when it was declined as too small
+  //! (AdaptiveRefinementOptions::min_growth); the run then ended after this iteration
+  std::size_t declined_vertices = 0;
   double sum_g = 0.0;                 //!< Σ g over vertices with defined g (the stopping criterion's G_i)
   std::size_t defined_g = 0;          //!< vertices with defined g
   std::size_t moving = 0;             //!< vertices with a defined speed

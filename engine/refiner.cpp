@@ -223,8 +223,9 @@ class Refinement {
     if (!options_.adaptive_refinement) return false;
     const auto start = Clock::now();
     const std::size_t faces = mesh_.n_faces();
-    refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
+    const RefinementResult result = refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
     report.refined_faces += mesh_.n_faces() - faces;
+    report.declined_vertices += result.declined;
     seconds += seconds_since(start);
     return mesh_.n_faces() != faces;
   }

@@ -13,6 +13,7 @@ nlohmann::json iteration_json(const IterationReport& r) {
           {"vertices", r.vertices},
           {"faces", r.faces},
           {"refined_faces", r.refined_faces},
+          {"declined_vertices", r.declined_vertices},
           {"sum_g", r.sum_g},
           {"sum_g_per_vertex", r.sum_g_per_vertex()},
           {"defined_g", r.defined_g},

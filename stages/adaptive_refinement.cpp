@@ -16,7 +16,8 @@ namespace mvflow {
 
 bool AdaptiveRefinementOptions::check() const {
   return std::isfinite(curvature_factor) && std::isfinite(min_edge_relative) && std::isfinite(min_edge_pixels) &&
-         curvature_factor > 0.0 && min_edge_relative >= 0.0 && min_edge_pixels >= 0.0;
+         curvature_factor > 0.0 && min_edge_relative >= 0.0 && min_edge_pixels >= 0.0 && min_growth >= 0.0 &&
+         min_growth < 1.0;
 }
 
 namespace {
@@ -108,6 +109,12 @@ RefinementResult refine_adaptively(TriMesh& mesh, const VertexFields& fields, do
       std::max(options.min_edge_relative * bounding_box_diagonal(mesh), options.min_edge_pixels * pixel_size);
   result.marked_vertices = mark_red(mesh, fields, threshold, min_edge, marks);
   result.promoted_faces = close_red(mesh, marks);
+  const auto split_edges = static_cast<std::size_t>(std::count(marks.split.begin(), marks.split.end(), 1));
+  if (split_edges > 0 && static_cast<double>(split_edges) < options.min_growth * static_cast<double>(mesh.n_vertices())) {
+    result.promoted_faces = 0;
+    result.declined = split_edges;
+    return result;
+  }
 
   // Midpoints, appended in edge-id order.
   std::vector<VertexHandle> midpoint(mesh.n_edges());

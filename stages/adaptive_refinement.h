@@ -22,8 +22,13 @@ struct AdaptiveRefinementOptions {
   //! patch the photographs cannot place the new vertices. 5 (the patch width); 0 in the thesis
   //! preset. ≥ 0. See the README, "Defaults and differences", for the measurement.
   double min_edge_pixels = 5.0;
+  //! A refinement that would add fewer than min_growth × #V vertices is not done: the mesh is
+  //! left unchanged (RefinementResult::declined). 0: every refinement is done (the thesis). In
+  //! [0, 1). The engine's coarse-to-fine schedule sets 0.1 (RefineOptions::adaptive).
+  double min_growth = 0.0;
 
-  //! True when both values are finite, curvature_factor > 0 and min_edge_relative ≥ 0.
+  //! True when every value is finite, curvature_factor > 0, min_edge_relative ≥ 0,
+  //! min_edge_pixels ≥ 0 and 0 ≤ min_growth < 1.
   bool check() const;
 };
 
@@ -34,6 +39,9 @@ struct RefinementResult {
   std::size_t promoted_faces = 0;   //!< of red_faces: closure faces with ≥ 2 split edges
   std::size_t green_faces = 0;      //!< closure faces bisected (1 → 2)
   std::size_t new_vertices = 0;     //!< edge midpoints added (one per split edge)
+  //! Midpoints the refinement would have added when it was declined (fewer than
+  //! options.min_growth × #V; nothing was changed), else 0.
+  std::size_t declined = 0;
 };
 
 //! Refines \p mesh where it is curved (thesis 5.3.1 and figure 5.1; SPEC §5):
@@ -57,7 +65,9 @@ struct RefinementResult {
 //! growing; the tangential regularization of every iteration evens them out.
 //!
 //! Serial and deterministic (faces, edges and vertices in id order, no hash containers). Does
-//! nothing (and returns zeros except marked_vertices) when no face qualifies.
+//! nothing (and returns zeros except marked_vertices) when no face qualifies, and nothing but
+//! report the count in `declined` when fewer than options.min_growth × #V midpoints would be
+//! added.
 //!
 //! \param mesh           The surface, modified in place; closed or with boundary, manifold.
 //! \param fields         Per-vertex arrays sized #V: curvature_normal_length and the

@@ -158,6 +158,56 @@ TEST(Refiner, RefinesCoarseToFineWhenTheFlowHasConverged) {
   EXPECT_EQ(result.mesh.n_vertices(), iterations.back().vertices);
 }
 
+TEST(Refiner, ARefinementBelowTheMinimumGrowthEndsTheRun) {
+  // Reference: every refinement done (min_growth 0). The first refinement that adds fewer than
+  // 60 % vertices adds `added` to `before`; the ones before it grew the mesh more.
+  const SmallScene& s = small_scene();
+  RefineOptions options = few_iterations(24);
+  options.stopping.min_iterations = 6;
+  options.stopping.epsilon_percent = 50.0;  // "converged" as soon as the rules may fire
+  options.adaptive.min_growth = 0.0;
+  const RefineResult every = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_NE(every.summary.status, RefineStatus::Failed) << every.summary.message;
+  const auto& iterations = every.summary.iterations;
+  std::size_t first = 0, before = 0, added = 0;
+  double growth = 0.0, earlier_growth = INFINITY;
+  for (; first + 1 < iterations.size(); ++first) {
+    if (!iterations[first].stop.starts_with("refined (")) continue;
+    before = iterations[first].vertices;
+    added = iterations[first + 1].vertices - before;
+    growth = static_cast<double>(added) / static_cast<double>(before);
+    std::printf("[measured] refinement after iteration %zu: %zu -> %zu vertices (growth %.3f)\n", first + 1, before,
+                before + added, growth);
+    if (growth < 0.6) break;
+    earlier_growth = std::min(earlier_growth, growth);
+  }
+  ASSERT_LT(first + 1, iterations.size()) << "no refinement below 60 % followed by an iteration";
+  ASSERT_GT(earlier_growth, 1.5 * growth);
+
+  // A minimum just above that growth declines it: the run ends there, "converged", with the mesh
+  // of the same iterations without refinement (a run whose budget ends at that iteration).
+  options.adaptive.min_growth = 1.5 * growth;
+  const RefineResult declined = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_EQ(declined.summary.status, RefineStatus::Converged) << declined.summary.message;
+  ASSERT_EQ(declined.summary.iterations.size(), first + 1);
+  EXPECT_EQ(declined.summary.iterations.back().declined_vertices, added);
+  EXPECT_EQ(declined.summary.iterations.back().refined_faces, 0u);
+  EXPECT_EQ(declined.summary.iterations.back().stop, "converged");
+  RefineOptions budget = options;
+  budget.adaptive.min_growth = 0.0;
+  budget.stopping.max_iterations = static_cast<int>(first + 1);
+  budget.stopping.min_iterations = std::min(budget.stopping.min_iterations, budget.stopping.max_iterations);
+  const RefineResult unrefined = refine_mesh(s.scene, s.initial, budget, {});
+  EXPECT_EQ(positions(declined), positions(unrefined));
+
+  // A minimum just below it refines exactly as the reference.
+  options.adaptive.min_growth = 0.5 * growth;
+  const RefineResult accepted = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_GT(accepted.summary.iterations.size(), first + 1);
+  EXPECT_EQ(accepted.summary.iterations[first + 1].vertices, before + added);
+  EXPECT_EQ(accepted.summary.iterations[first].declined_vertices, 0u);
+}
+
 TEST(Refiner, CancelStopsBetweenBlocks) {
   const SmallScene& s = small_scene();
   std::atomic<bool> cancel{false};

@@ -202,6 +202,31 @@ TEST_F(BumpedSphere, RefinesOnlyTheMarkedRegionAndItsClosure) {
   EXPECT_EQ(kept, before.faces - refined);
 }
 
+TEST_F(BumpedSphere, MinimumGrowthDeclinesASmallRefinementAndChangesNothing) {
+  TriMesh reference = bump.mesh;
+  const RefinementResult all = refine_adaptively(reference, fields, bump.reference_edge);  // min_growth 0
+  ASSERT_GT(all.new_vertices, 0u);
+  const double growth = static_cast<double>(all.new_vertices) / static_cast<double>(bump.mesh.n_vertices());
+
+  TriMesh declined = bump.mesh;  // just above the growth: declined, the mesh untouched
+  const RefinementResult none =
+      refine_adaptively(declined, fields, bump.reference_edge, {.min_growth = growth * 1.0001});
+  EXPECT_EQ(none.declined, all.new_vertices);
+  EXPECT_EQ(none.new_vertices + none.red_faces + none.green_faces + none.promoted_faces, 0u);
+  EXPECT_EQ(none.marked_vertices, all.marked_vertices);
+  EXPECT_EQ(triangles_of(declined), triangles_of(bump.mesh));
+  EXPECT_EQ(positions_of(declined), positions_of(bump.mesh));
+
+  TriMesh accepted = bump.mesh;  // just below the growth: done, exactly as without a minimum
+  const RefinementResult done = refine_adaptively(accepted, fields, bump.reference_edge, {.min_growth = growth * 0.9999});
+  EXPECT_EQ(done.declined, 0u);
+  EXPECT_EQ(done.new_vertices, all.new_vertices);
+  EXPECT_EQ(triangles_of(accepted), triangles_of(reference));
+  EXPECT_EQ(positions_of(accepted), positions_of(reference));
+
+  for (const double bad : {-0.1, 1.0, std::nan("")}) EXPECT_FALSE(AdaptiveRefinementOptions{.min_growth = bad}.check()) << bad;
+}
+
 TEST_F(BumpedSphere, MinimumEdgeBlocksRefinement) {
   // Per marked face its shortest edge, relative to the bounding-box diagonal: a minimum at or
   // above the largest of these blocks every face, one below the smallest blocks none.

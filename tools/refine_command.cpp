@@ -61,6 +61,7 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"adaptive_refinement", o.adaptive_refinement},
           {"adaptive_curvature_factor", o.adaptive.curvature_factor},
           {"adaptive_min_edge_pixels", o.adaptive.min_edge_pixels},
+          {"adaptive_min_growth", o.adaptive.min_growth},
           {"refine_when", o.refinement_schedule == RefinementSchedule::EveryIteration ? "iteration" : "converged"},
           {"convergence_test", o.stopping.test == ConvergenceTest::EachLookback ? "each-lookback" : "no-improvement"},
           {"excluded_views", o.excluded_views},
@@ -85,6 +86,7 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   if (command.count("--keep-inside-silhouettes") > 0) options.keep_inside_silhouettes = true;
   set("--refine-min-pixels", options.adaptive.min_edge_pixels, given.adaptive.min_edge_pixels);
   set("--refine-curvature", options.adaptive.curvature_factor, given.adaptive.curvature_factor);
+  set("--refine-min-growth", options.adaptive.min_growth, given.adaptive.min_growth);
   set("--max-view-angle", options.visibility.max_angle_degrees, given.visibility.max_angle_degrees);
   set("--smoothing", options.smoothing.lambda_dt, given.smoothing.lambda_dt);
   set("--smoothing-steps", options.smoothing.steps, given.smoothing.steps);
@@ -204,6 +206,10 @@ void add_refine_command(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   c->add_option("--refine-curvature", o.adaptive.curvature_factor,
                 "Adaptive refinement marks vertices whose curvature-normal length exceeds this × e_S")
+      ->capture_default_str();
+  c->add_option("--refine-min-growth", o.adaptive.min_growth,
+                "A refinement that would add fewer than this fraction of the vertices is not done (coarse to fine, "
+                "the run then ends converged; thesis preset: 0)")
       ->capture_default_str();
   c->add_option("--refine-when", args->refine_when,
                 "Adaptive refinement before every iteration (the thesis) or when the flow has converged at the "
