@@ -17,7 +17,8 @@ void RefineOptions::check() const {
   require(regularization.check(), "regularization (strength in (0,1], steps >= 0)");
   require(stopping.check(), "stopping (epsilon, iterations, lookback, tolerance)");
   require(remeshing.check(), "remeshing factors");
-  require(adaptive.check(), "adaptive refinement thresholds");
+  require(adaptive.check(), "adaptive refinement thresholds (min growth in [0, 1))");
+  require(untangling.check(), "untangling (rounds >= 0, ring >= 0, steps >= 1, fraction in (0, 1])");
   require(block_size >= 1, "block size >= 1");
   require(silhouettes.check(), "silhouettes (threshold in [0, 1), dilation >= 0)");
   require(photo.photo.half_patch == visibility.half_patch, "the visibility patch must equal the photo patch");
@@ -36,6 +37,7 @@ RefineOptions thesis_preset() {
   options.step_control = false;
   options.adaptive.min_edge_pixels = 0.0;
   options.adaptive.min_growth = 0.0;
+  options.untangling.max_rounds = 0;
   options.refinement_schedule = RefinementSchedule::EveryIteration;
   options.stopping.test = ConvergenceTest::EachLookback;
   return options;

@@ -15,6 +15,7 @@
 #include "stages/smoothing.h"
 #include "stages/speed.h"
 #include "stages/stopping.h"
+#include "stages/untangling.h"
 #include "stages/visibility.h"
 
 namespace mvflow {
@@ -65,6 +66,9 @@ struct RefineOptions {
   //! made the result no better; README, "Defaults and differences"). 0 in the thesis preset.
   AdaptiveRefinementOptions adaptive{.min_growth = 0.1};
   RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration
+  //! Folds removed where the flow has settled: before each coarse-to-fine refinement (so that a
+  //! fold is not refined into more) and at the end. max_rounds 0 (the thesis preset) disables.
+  UntanglingOptions untangling;
   //! Vertices per block (one graph node per block and stage). 128: on the default scene (800
   //! vertices) 1024 left one block and no speed-up from a second thread; at 10k vertices 64, 128
   //! and 512 gave the same time (README, "Performance").

@@ -24,6 +24,7 @@
 #include "stages/self_intersections.h"
 #include "stages/silhouette_constraint.h"
 #include "stages/smoothing.h"
+#include "stages/untangling.h"
 #include "stages/visibility.h"
 
 namespace mvflow {
@@ -161,6 +162,7 @@ class Refinement {
         status = RefineStatus::Cancelled;
         break;
       }
+      crossings_known_ = false;  // the surface moved
       fill_report(report, edges, refinement_seconds, iteration_start);
       StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move, data_.total.defined_g);
       report.stop = to_string(reason);
@@ -178,12 +180,14 @@ class Refinement {
     }
 
     progress(static_cast<int>(summary.iterations.size()), "finishing");
+    if (status != RefineStatus::Cancelled && !crossings_known_) untangle_folds();
+    summary.untangled_pairs = untangled_pairs_;
     const SurfaceState final_state = evaluate_surface(mesh_, views_, options_);
     summary.status = status;
     summary.final_vertices = mesh_.n_vertices();
     summary.final_faces = mesh_.n_faces();
     summary.final_sum_g_per_vertex = final_state.sum_g_per_vertex;
-    summary.self_intersections = count_self_intersections(mesh_);
+    summary.self_intersections = crossings_known_ ? crossings_left_ : count_self_intersections(mesh_);
     result.mesh.topology = mesh_;
     result.mesh.quality = final_state.g;
     result.mesh.colors = final_state.colours;
@@ -217,6 +221,19 @@ class Refinement {
     apply_regularization(mesh_, options_.regularization);
   }
 
+  // Removes the folds of the current surface (UntanglingOptions); counted for the summary.
+  void untangle_folds() {
+    if (options_.untangling.max_rounds == 0) return;
+    const UntanglingResult result = untangle(mesh_, options_.untangling);
+    untangled_pairs_ += result.crossing_pairs_before;
+    crossings_known_ = true;
+    crossings_left_ = result.crossing_pairs_after;
+    if (control_.logger && result.crossing_pairs_before > 0)
+      control_.logger->info("untangled {} crossing face pairs ({} left) by smoothing {} vertices in {} rounds",
+                            result.crossing_pairs_before, result.crossing_pairs_after, result.smoothed_vertices,
+                            result.rounds);
+  }
+
   // Adaptive refinement from the curvature of the last iteration (SPEC §5). True when the
   // topology changed, so the blocks, fields, Embree scene and graph are rebuilt.
   bool adapt(IterationReport& report, double& seconds) {
@@ -235,7 +252,9 @@ class Refinement {
   bool refine_at_convergence(StopReason reason, IterationReport& report) {
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     if (reason != StopReason::Converged && reason != StopReason::StepSmall) return false;
-    double seconds = 0.0;
+    const auto start = Clock::now();
+    untangle_folds();
+    double seconds = seconds_since(start);
     if (!adapt(report, seconds)) return false;
     report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
     report.stop = std::string("refined (") + to_string(reason) + ")";
@@ -284,6 +303,11 @@ class Refinement {
   IterationData data_;
   double reference_edge_ = 0.0;
   double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
+  std::size_t untangled_pairs_ = 0;
+  //! True when crossings_left_ counts the crossing face pairs of the current positions (set by
+  //! untangle_folds, cleared by every iteration), so that they are not searched twice.
+  bool crossings_known_ = false;
+  std::size_t crossings_left_ = 0;
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
   std::optional<SilhouetteConstraint> inside_;
 };

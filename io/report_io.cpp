@@ -40,7 +40,8 @@ nlohmann::json report_to_json(const RefineSummary& summary, const nlohmann::json
                        {"sum_g_per_vertex", summary.initial_sum_g_per_vertex}}},
           {"final", {{"vertices", summary.final_vertices}, {"faces", summary.final_faces},
                      {"sum_g_per_vertex", summary.final_sum_g_per_vertex},
-                     {"self_intersecting_face_pairs", summary.self_intersections}}},
+                     {"self_intersecting_face_pairs", summary.self_intersections},
+                     {"untangled_face_pairs", summary.untangled_pairs}}},
           {"seconds", summary.seconds},
           {"iterations", iterations}};
 }

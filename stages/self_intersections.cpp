@@ -38,9 +38,11 @@ bool triangles_cross(const Triangle& x, const Triangle& y) {
 
 }  // namespace
 
-std::size_t count_self_intersections(const TriMesh& mesh) {
+std::size_t count_self_intersections(const TriMesh& mesh) { return self_intersecting_pairs(mesh).size(); }
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(const TriMesh& mesh) {
   const std::size_t n = mesh.n_faces();
-  if (n < 2) return 0;
+  if (n < 2) return {};
   std::vector<Triangle> triangles(n);
   std::vector<std::array<int, 3>> corners(n);
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -87,7 +89,8 @@ std::size_t count_self_intersections(const TriMesh& mesh) {
     i = j;
   }
   std::sort(crossing.begin(), crossing.end());
-  return static_cast<std::size_t>(std::unique(crossing.begin(), crossing.end()) - crossing.begin());
+  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+  return crossing;
 }
 
 }  // namespace mvflow

@@ -2,6 +2,9 @@
 // Counting pairs of faces that cross each other: a refined surface must not fold through itself.
 
 #include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "engine/mesh.h"
 
@@ -11,5 +14,8 @@ namespace mvflow {
 //! passes through the other). Faces are bucketed in a uniform grid of cell size ≈ the mean edge
 //! length, so the cost is about linear in the number of faces. Coplanar overlaps are not counted.
 std::size_t count_self_intersections(const TriMesh& mesh);
+
+//! The pairs count_self_intersections counts, as (smaller face id, larger face id), sorted.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(const TriMesh& mesh);
 
 }  // namespace mvflow

@@ -32,9 +32,8 @@ Distances evaluate(const std::filesystem::path& mesh, const std::filesystem::pat
 }
 
 // Renders `synth SYNTH_ARGS`, refines, evaluates; checks the target and prints the numbers.
-// \p max_self_intersections: intersecting face pairs allowed in the refined mesh.
-void expect_refinement_halves_the_error(const std::string& name, const std::string& synth_arguments,
-                                        int max_self_intersections = 0) {
+// The refined mesh must have no intersecting face pairs.
+void expect_refinement_halves_the_error(const std::string& name, const std::string& synth_arguments) {
   const test::ScratchFolder dir;
   const auto scene = dir.path() / "scene";
   const test::CommandResult synth = test::run_mvflow("synth " + synth_arguments + " -o " + scene.string());
@@ -59,7 +58,7 @@ void expect_refinement_halves_the_error(const std::string& name, const std::stri
   EXPECT_LE(after.mean, 0.5 * before.mean);
   EXPECT_LE(after.accuracy, 0.5 * before.accuracy);
   EXPECT_LT(g_after, g_before);
-  EXPECT_LE(r.at("final").at("self_intersecting_face_pairs").get<int>(), max_self_intersections);
+  EXPECT_EQ(r.at("final").at("self_intersecting_face_pairs").get<int>(), 0);
 
   const test::CommandResult info = test::run_mvflow("info " + scene.string() + " --mesh " + refined.string());
   ASSERT_EQ(info.exit_code, 0) << info.output;
@@ -80,12 +79,10 @@ TEST(Quality, ConcavePeanut) { expect_refinement_halves_the_error("peanut", "--p
 TEST(Quality, Bunny) {
   if (!std::filesystem::exists(std::filesystem::path(MVFLOW_SHARED_DATA) / "models" / "bunny-lowres-npm.obj"))
     GTEST_SKIP() << "the bunny model is not in " << MVFLOW_SHARED_DATA;
-  // A few intersecting face pairs come and go with the last bits of the flow on the bunny
-  // (~9 500 faces): over render seeds 1–6 the refined mesh had 0, 0, 7, 1, 2, 0 pairs with the
-  // photo kernel in double and 1, 2, 0, 0, 1, 0 with its float interpolation and one-pass
-  // variance, at the same accuracy (mean distance 0.0149 and 0.0150 on average); seed 1 is the
-  // one below.
-  expect_refinement_halves_the_error("bunny", "--preset bunny" + kSmall, 10);
+  // Before the untangling, a few intersecting face pairs came and went with the last bits of the
+  // flow on the bunny (render seeds 1–6: 0–7 pairs of ~9 500 faces); the refined mesh must now
+  // have none, like the other scenes.
+  expect_refinement_halves_the_error("bunny", "--preset bunny" + kSmall);
 }
 
 }  // namespace

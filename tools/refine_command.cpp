@@ -62,6 +62,7 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"adaptive_curvature_factor", o.adaptive.curvature_factor},
           {"adaptive_min_edge_pixels", o.adaptive.min_edge_pixels},
           {"adaptive_min_growth", o.adaptive.min_growth},
+          {"untangle_rounds", o.untangling.max_rounds},
           {"refine_when", o.refinement_schedule == RefinementSchedule::EveryIteration ? "iteration" : "converged"},
           {"convergence_test", o.stopping.test == ConvergenceTest::EachLookback ? "each-lookback" : "no-improvement"},
           {"excluded_views", o.excluded_views},
@@ -87,6 +88,7 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--refine-min-pixels", options.adaptive.min_edge_pixels, given.adaptive.min_edge_pixels);
   set("--refine-curvature", options.adaptive.curvature_factor, given.adaptive.curvature_factor);
   set("--refine-min-growth", options.adaptive.min_growth, given.adaptive.min_growth);
+  set("--untangle-rounds", options.untangling.max_rounds, given.untangling.max_rounds);
   set("--max-view-angle", options.visibility.max_angle_degrees, given.visibility.max_angle_degrees);
   set("--smoothing", options.smoothing.lambda_dt, given.smoothing.lambda_dt);
   set("--smoothing-steps", options.smoothing.steps, given.smoothing.steps);
@@ -156,7 +158,8 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   fmt::print("refined    {} → {} vertices in {} iterations, {:.2f} s ({})\n", s.initial_vertices, s.final_vertices,
              s.iterations.size(), s.seconds, to_string(s.status));
   fmt::print("Σg/vertex  {:.6g} → {:.6g}\n", s.initial_sum_g_per_vertex, s.final_sum_g_per_vertex);
-  fmt::print("mesh       {} ({} self-intersecting face pairs)\n", args.output, s.self_intersections);
+  fmt::print("mesh       {} ({} self-intersecting face pairs; {} untangled during the run)\n", args.output,
+             s.self_intersections, s.untangled_pairs);
   if (!args.report.empty()) fmt::print("report     {}\n", args.report);
   return kOk;
 }
@@ -206,6 +209,10 @@ void add_refine_command(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   c->add_option("--refine-curvature", o.adaptive.curvature_factor,
                 "Adaptive refinement marks vertices whose curvature-normal length exceeds this × e_S")
+      ->capture_default_str();
+  c->add_option("--untangle-rounds", o.untangling.max_rounds,
+                "Rounds of fold removal (smoothing around crossing faces) before each refinement and at the end; "
+                "0 disables (thesis preset)")
       ->capture_default_str();
   c->add_option("--refine-min-growth", o.adaptive.min_growth,
                 "A refinement that would add fewer than this fraction of the vertices is not done (coarse to fine, "
