@@ -30,8 +30,9 @@ enum class EngineKind {
 enum class RefinementSchedule {
   EveryIteration,  //!< before every iteration but the first (thesis §5.3.4)
   //! Coarse to fine: when the flow has converged at the current resolution (the Converged or
-  //! StepSmall rule fires), then the stopping rules start afresh; the run ends when they fire
-  //! and refinement adds nothing. README, "Defaults and differences".
+  //! StepSmall rule fires), then the stopping rules start afresh; the run ends (with that rule's
+  //! status) when they fire and refinement adds nothing or is declined as too small
+  //! (AdaptiveRefinementOptions::min_growth). README, "Defaults and differences".
   AtConvergence,
 };
 
@@ -60,14 +61,12 @@ struct RefineOptions {
   bool global_remeshing = true;        //!< split/collapse once before the flow (SPEC §5)
   RemeshingOptions remeshing;
   bool adaptive_refinement = true;     //!< quadrisect high-curvature regions between iterations
-  //! min_growth 0.1 here: coarse to fine, a refinement that would add fewer than 10 % vertices
-  //! ends the run ("converged") instead of restarting the stopping rules for ≥ min_iterations
-  //! more iterations of the whole mesh for a local change (on the sphere scenes those iterations
-  //! made the result no better; README, "Defaults and differences"). 0 in the thesis preset.
-  AdaptiveRefinementOptions adaptive{.min_growth = 0.1};
+  AdaptiveRefinementOptions adaptive;
+
   RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration
-  //! Folds removed where the flow has settled: before each coarse-to-fine refinement (so that a
-  //! fold is not refined into more) and at the end. max_rounds 0 (the thesis preset) disables.
+  //! Folds removed where the flow has settled: before each coarse-to-fine refinement (then the
+  //! curvature is recomputed, so that the marks do not follow a removed fold) and at the end of
+  //! the run (with either schedule). max_rounds 0 (the thesis preset) disables.
   UntanglingOptions untangling;
   //! Vertices per block (one graph node per block and stage). 128: on the default scene (800
   //! vertices) 1024 left one block and no speed-up from a second thread; at 10k vertices 64, 128

@@ -25,7 +25,8 @@ struct IterationReport {
   //! after it when its stop says "refined (…)" (AtConvergence)
   std::size_t refined_faces = 0;
   //! vertices a refinement would have added when it was declined as too small
-  //! (AdaptiveRefinementOptions::min_growth); the run then ended after this iteration
+  //! (AdaptiveRefinementOptions::min_growth); coarse to fine, the run then ended after this
+  //! iteration
   std::size_t declined_vertices = 0;
   double sum_g = 0.0;                 //!< Σ g over vertices with defined g (the stopping criterion's G_i)
   std::size_t defined_g = 0;          //!< vertices with defined g
@@ -56,7 +57,7 @@ struct RefineSummary {
   double initial_sum_g_per_vertex = 0.0;  //!< after the global remeshing, before the flow
   double final_sum_g_per_vertex = 0.0;    //!< at the final positions
   std::size_t self_intersections = 0;     //!< pairs of non-adjacent faces that intersect (final mesh)
-  std::size_t untangled_pairs = 0;        //!< crossing face pairs the untangling found, summed over its calls
+  std::size_t untangled_pairs = 0;        //!< crossing face pairs the untangling removed, summed over its calls
   double seconds = 0.0;
   std::vector<IterationReport> iterations;
 };

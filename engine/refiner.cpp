@@ -17,6 +17,7 @@
 #include "engine/iteration_graph.h"
 #include "engine/mesh_stats.h"
 #include "stages/adaptive_refinement.h"
+#include "stages/curvature.h"
 #include "stages/normals.h"
 #include "stages/photo_consistency.h"
 #include "stages/regularization.h"
@@ -222,16 +223,35 @@ class Refinement {
   }
 
   // Removes the folds of the current surface (UntanglingOptions); counted for the summary.
-  void untangle_folds() {
-    if (options_.untangling.max_rounds == 0) return;
+  // True when it moved vertices.
+  bool untangle_folds() {
+    if (options_.untangling.max_rounds == 0) return false;
+    const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const UntanglingResult result = untangle(mesh_, options_.untangling);
-    untangled_pairs_ += result.crossing_pairs_before;
+    untangled_pairs_ += result.crossing_pairs_before - result.crossing_pairs_after;
     crossings_known_ = true;
     crossings_left_ = result.crossing_pairs_after;
+    if (inside_ && result.rounds > 0) {  // the silhouette constraint holds for these moves too
+      for (auto v : mesh_.vertices()) {
+        const Eigen::Vector3d& from = before[static_cast<std::size_t>(v.idx())];
+        const Eigen::Vector3d to = to_eigen(mesh_.point(v));
+        if (to != from) mesh_.set_point(v, to_openmesh(inside_->limit_move(from, to)));
+      }
+      crossings_known_ = false;  // a limited move may have kept a crossing
+    }
     if (control_.logger && result.crossing_pairs_before > 0)
       control_.logger->info("untangled {} crossing face pairs ({} left) by smoothing {} vertices in {} rounds",
                             result.crossing_pairs_before, result.crossing_pairs_after, result.smoothed_vertices,
                             result.rounds);
+    return result.rounds > 0;
+  }
+
+  // Normals and curvature at the current positions for every vertex (after the untangling moved
+  // some), for the adaptive refinement's marks.
+  void update_curvature() {
+    const IndexRange all{0, static_cast<std::uint32_t>(mesh_.n_vertices())};
+    compute_normals(mesh_, all, data_.fields);
+    compute_mean_curvature(mesh_, all, data_.fields, options_.curvature);
   }
 
   // Adaptive refinement from the curvature of the last iteration (SPEC §5). True when the
@@ -244,7 +264,9 @@ class Refinement {
     report.refined_faces += mesh_.n_faces() - faces;
     report.declined_vertices += result.declined;
     seconds += seconds_since(start);
-    return mesh_.n_faces() != faces;
+    if (mesh_.n_faces() == faces) return false;
+    crossings_known_ = false;  // new faces, new ids
+    return true;
   }
 
   // The coarse-to-fine schedule: when the flow has settled at this resolution, refine; true when
@@ -253,10 +275,11 @@ class Refinement {
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     if (reason != StopReason::Converged && reason != StopReason::StepSmall) return false;
     const auto start = Clock::now();
-    untangle_folds();
+    if (untangle_folds()) update_curvature();  // so that the marks do not follow a removed fold
     double seconds = seconds_since(start);
-    if (!adapt(report, seconds)) return false;
+    const bool refined = adapt(report, seconds);
     report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
+    if (!refined) return false;
     report.stop = std::string("refined (") + to_string(reason) + ")";
     data_.reset_topology();
     graph_.reset();

@@ -23,9 +23,11 @@ struct AdaptiveRefinementOptions {
   //! preset. ≥ 0. See the README, "Defaults and differences", for the measurement.
   double min_edge_pixels = 5.0;
   //! A refinement that would add fewer than min_growth × #V vertices is not done: the mesh is
-  //! left unchanged (RefinementResult::declined). 0: every refinement is done (the thesis). In
-  //! [0, 1). The engine's coarse-to-fine schedule sets 0.1 (RefineOptions::adaptive).
-  double min_growth = 0.0;
+  //! left unchanged (RefinementResult::declined). Coarse to fine, each refinement restarts the
+  //! stopping rules, so a small one costs ≥ min_iterations more iterations of the whole mesh for a
+  //! local change; declined, it ends the run. 0.1; 0 (every refinement is done) in the thesis
+  //! preset. In [0, 1). README, "Defaults and differences", for the measurement.
+  double min_growth = 0.1;
 
   //! True when every value is finite, curvature_factor > 0, min_edge_relative ≥ 0,
   //! min_edge_pixels ≥ 0 and 0 ≤ min_growth < 1.
@@ -65,9 +67,9 @@ struct RefinementResult {
 //! growing; the tangential regularization of every iteration evens them out.
 //!
 //! Serial and deterministic (faces, edges and vertices in id order, no hash containers). Does
-//! nothing (and returns zeros except marked_vertices) when no face qualifies, and nothing but
-//! report the count in `declined` when fewer than options.min_growth × #V midpoints would be
-//! added.
+//! nothing (and returns zeros except marked_vertices) when no face qualifies, and leaves the mesh
+//! unchanged (returning marked_vertices and the midpoint count in `declined`, zeros otherwise)
+//! when fewer than options.min_growth × #V midpoints would be added.
 //!
 //! \param mesh           The surface, modified in place; closed or with boundary, manifold.
 //! \param fields         Per-vertex arrays sized #V: curvature_normal_length and the

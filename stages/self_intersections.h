@@ -16,6 +16,7 @@ namespace mvflow {
 std::size_t count_self_intersections(const TriMesh& mesh);
 
 //! The pairs count_self_intersections counts, as (smaller face id, larger face id), sorted.
+//! \pre \p mesh has no deleted elements (ids contiguous), as for count_self_intersections.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(const TriMesh& mesh);
 
 }  // namespace mvflow

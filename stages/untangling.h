@@ -34,6 +34,7 @@ struct UntanglingResult {
 //! until no pair crosses or options.max_rounds rounds are used. Only vertices near crossing
 //! faces move; boundary vertices never do. Serial and deterministic (ids in order, Jacobi steps).
 //! \param mesh The surface, modified in place; its topology is not changed.
+//! \pre \p mesh has no deleted elements (ids contiguous).
 //! \throw Error if the options are invalid.
 UntanglingResult untangle(TriMesh& mesh, const UntanglingOptions& options = {});
 

@@ -105,13 +105,17 @@ std::vector<Triangle> marked_faces(const TriMesh& mesh, const VertexFields& fiel
   return {marked.begin(), marked.end()};
 }
 
+// Every refinement done, however small: the geometric tests below refine a few faces of a sphere.
+constexpr AdaptiveRefinementOptions kEveryRefinement{.min_growth = 0.0};
+
 TEST(AdaptiveRefinementOptions, DefaultsAreTheThesisValuesAndValid) {
   const AdaptiveRefinementOptions options;
   EXPECT_TRUE(options.check());
   EXPECT_EQ(options.curvature_factor, 0.5);     // tolerance e_S / 2, thesis B.7
   EXPECT_EQ(options.min_edge_relative, 1e-3);   // thesis B.4's 1e-3, relative (SPEC §9)
+  EXPECT_EQ(options.min_growth, 0.1);           // not the thesis's (0): README, "Defaults and differences"
   EXPECT_FALSE((AdaptiveRefinementOptions{.curvature_factor = 0.0}.check()));
-  EXPECT_FALSE((AdaptiveRefinementOptions{.min_edge_relative = -1.0}.check()));
+  EXPECT_FALSE((AdaptiveRefinementOptions{.min_edge_relative = -1.0, .min_growth = 0.0}.check()));
   EXPECT_FALSE((AdaptiveRefinementOptions{.curvature_factor = NAN}.check()));
   TriMesh mesh = test::icosphere(1.0, 1);
   const VertexFields fields = curvature_of(mesh);
@@ -125,7 +129,7 @@ TEST(AdaptiveRefinement, SmoothSphereBelowTheThresholdIsUntouched) {
   const VertexFields fields = curvature_of(mesh);
   const auto positions = positions_of(mesh);
   const auto faces = triangles_of(mesh);
-  const RefinementResult r = refine_adaptively(mesh, fields, stats_of(mesh).shortest_edge);
+  const RefinementResult r = refine_adaptively(mesh, fields, stats_of(mesh).shortest_edge, kEveryRefinement);
   EXPECT_EQ(r.marked_vertices, 0u);
   EXPECT_EQ(r.red_faces + r.green_faces + r.new_vertices, 0u);
   EXPECT_EQ(positions_of(mesh), positions);
@@ -155,7 +159,7 @@ TEST_F(BumpedSphere, RefinesOnlyTheMarkedRegionAndItsClosure) {
   std::set<std::uint32_t> region;  // the corners of the marked faces
   for (const auto& t : marked) region.insert(t.begin(), t.end());
 
-  const RefinementResult r = refine_adaptively(mesh, fields, bump.reference_edge);
+  const RefinementResult r = refine_adaptively(mesh, fields, bump.reference_edge, kEveryRefinement);
   const MeshStats after = stats_of(mesh);
   std::printf("[measured] marked vertices %zu, marked faces %zu, red %zu (promoted %zu), green %zu, new vertices "
               "%zu; faces %zu -> %zu\n",
@@ -204,7 +208,7 @@ TEST_F(BumpedSphere, RefinesOnlyTheMarkedRegionAndItsClosure) {
 
 TEST_F(BumpedSphere, MinimumGrowthDeclinesASmallRefinementAndChangesNothing) {
   TriMesh reference = bump.mesh;
-  const RefinementResult all = refine_adaptively(reference, fields, bump.reference_edge);  // min_growth 0
+  const RefinementResult all = refine_adaptively(reference, fields, bump.reference_edge, kEveryRefinement);
   ASSERT_GT(all.new_vertices, 0u);
   const double growth = static_cast<double>(all.new_vertices) / static_cast<double>(bump.mesh.n_vertices());
 
@@ -243,7 +247,7 @@ TEST_F(BumpedSphere, MinimumEdgeBlocksRefinement) {
 
   TriMesh blocked = bump.mesh;
   const RefinementResult none =
-      refine_adaptively(blocked, fields, bump.reference_edge, {.min_edge_relative = largest * 1.0001});
+      refine_adaptively(blocked, fields, bump.reference_edge, {.min_edge_relative = largest * 1.0001, .min_growth = 0.0});
   EXPECT_GT(none.marked_vertices, 0u);
   EXPECT_EQ(none.red_faces + none.green_faces + none.new_vertices, 0u);
   EXPECT_EQ(triangles_of(blocked), triangles_of(bump.mesh));
@@ -254,11 +258,11 @@ TEST_F(BumpedSphere, MinimumEdgeBlocksRefinement) {
   TriMesh blocked_by_pixels = bump.mesh;
   const double pixel_size = largest * 1.0001 * diagonal / 5.0;
   const RefinementResult none_by_pixels =
-      refine_adaptively(blocked_by_pixels, fields, bump.reference_edge, {.min_edge_pixels = 5.0}, pixel_size);
+      refine_adaptively(blocked_by_pixels, fields, bump.reference_edge, {.min_edge_pixels = 5.0, .min_growth = 0.0}, pixel_size);
   EXPECT_EQ(none_by_pixels.red_faces + none_by_pixels.new_vertices, 0u);
   TriMesh pixels_between = bump.mesh;
   const RefinementResult some_by_pixels = refine_adaptively(
-      pixels_between, fields, bump.reference_edge, {.min_edge_pixels = 5.0}, 0.5 * (smallest + largest) * diagonal / 5.0);
+      pixels_between, fields, bump.reference_edge, {.min_edge_pixels = 5.0, .min_growth = 0.0}, 0.5 * (smallest + largest) * diagonal / 5.0);
   EXPECT_EQ(some_by_pixels.red_faces - some_by_pixels.promoted_faces,
             marked_faces(bump.mesh, fields, threshold, 0.5 * (smallest + largest) * diagonal).size());
   EXPECT_THROW(refine_adaptively(pixels_between, fields, bump.reference_edge, {}, -1.0), Error);
@@ -266,15 +270,15 @@ TEST_F(BumpedSphere, MinimumEdgeBlocksRefinement) {
   TriMesh partly = bump.mesh;  // between: only the faces whose edges are all long enough
   const double between = 0.5 * (smallest + largest);
   const RefinementResult some =
-      refine_adaptively(partly, fields, bump.reference_edge, {.min_edge_relative = between});
+      refine_adaptively(partly, fields, bump.reference_edge, {.min_edge_relative = between, .min_growth = 0.0});
   const auto expected = marked_faces(bump.mesh, fields, threshold, between * diagonal);
   EXPECT_EQ(some.red_faces - some.promoted_faces, expected.size());  // marked directly
 
   TriMesh allowed = bump.mesh;  // below all: refined as with the default 1e-3
   const RefinementResult all =
-      refine_adaptively(allowed, fields, bump.reference_edge, {.min_edge_relative = smallest * 0.9999});
+      refine_adaptively(allowed, fields, bump.reference_edge, {.min_edge_relative = smallest * 0.9999, .min_growth = 0.0});
   TriMesh by_default = bump.mesh;
-  const RefinementResult reference = refine_adaptively(by_default, fields, bump.reference_edge);
+  const RefinementResult reference = refine_adaptively(by_default, fields, bump.reference_edge, kEveryRefinement);
   std::printf("[measured] red faces: %zu blocked, %zu between, %zu below all, %zu by default\n", none.red_faces,
               some.red_faces, all.red_faces, reference.red_faces);
   EXPECT_GT(all.red_faces, 0u);
@@ -287,9 +291,9 @@ TEST_F(BumpedSphere, IsDeterministicAndUnitFree) {
   TriMesh scaled = bump.mesh;
   for (auto v : scaled.vertices()) scaled.set_point(v, scaled.point(v) * 1000.0);
   const VertexFields scaled_fields = curvature_of(scaled);
-  const RefinementResult a = refine_adaptively(bump.mesh, fields, bump.reference_edge);
-  const RefinementResult b = refine_adaptively(copy, fields, bump.reference_edge);
-  const RefinementResult c = refine_adaptively(scaled, scaled_fields, 1000.0 * bump.reference_edge);
+  const RefinementResult a = refine_adaptively(bump.mesh, fields, bump.reference_edge, kEveryRefinement);
+  const RefinementResult b = refine_adaptively(copy, fields, bump.reference_edge, kEveryRefinement);
+  const RefinementResult c = refine_adaptively(scaled, scaled_fields, 1000.0 * bump.reference_edge, kEveryRefinement);
   EXPECT_EQ(a.red_faces, b.red_faces);
   EXPECT_EQ(a.green_faces, b.green_faces);
   EXPECT_EQ(positions_of(bump.mesh), positions_of(copy));
@@ -307,7 +311,7 @@ TEST_F(BumpedSphere, RepeatedRefinementStaysConformingAndStops) {
   const double area = total_area(mesh);
   int rounds = 0;
   for (; rounds < 12; ++rounds) {
-    const RefinementResult r = refine_adaptively(mesh, curvature_of(mesh), bump.reference_edge);
+    const RefinementResult r = refine_adaptively(mesh, curvature_of(mesh), bump.reference_edge, kEveryRefinement);
     if (r.new_vertices == 0) break;
     const MeshStats s = stats_of(mesh);
     EXPECT_EQ(s.boundary_edges, 0u);
@@ -333,7 +337,7 @@ TEST(AdaptiveRefinement, FigureFiveOneOnAGrid) {
   fields.defined[centre] = kCurvatureDefined;
   fields.curvature_normal_length[centre] = 1.0;
   const double area = total_area(mesh);
-  const RefinementResult r = refine_adaptively(mesh, fields, 0.1);
+  const RefinementResult r = refine_adaptively(mesh, fields, 0.1, kEveryRefinement);
   const MeshStats after = stats_of(mesh);
   EXPECT_EQ(r.marked_vertices, 1u);
   EXPECT_EQ(r.red_faces, 6u);
@@ -364,7 +368,7 @@ TEST(AdaptiveRefinement, FacesWithTwoSplitEdgesArePromotedToRed) {
     fields.curvature_normal_length[v] = 1.0;
   }
   const double area = total_area(mesh);
-  const RefinementResult r = refine_adaptively(mesh, fields, 0.1);
+  const RefinementResult r = refine_adaptively(mesh, fields, 0.1, kEveryRefinement);
   const MeshStats after = stats_of(mesh);
   std::printf("[measured] two marked vertices: red %zu (promoted %zu), green %zu, new vertices %zu\n", r.red_faces,
               r.promoted_faces, r.green_faces, r.new_vertices);
@@ -393,7 +397,7 @@ TEST(AdaptiveRefinement, AtTheBoundaryOfAnOpenMesh) {
   fields.defined[v] = kCurvatureDefined;
   fields.curvature_normal_length[v] = 1.0;
   const double area = total_area(mesh);
-  const RefinementResult r = refine_adaptively(mesh, fields, 0.1);
+  const RefinementResult r = refine_adaptively(mesh, fields, 0.1, kEveryRefinement);
   const MeshStats after = stats_of(mesh);
   EXPECT_EQ(r.red_faces, 6u);
   EXPECT_GT(after.boundary_edges, before.boundary_edges);

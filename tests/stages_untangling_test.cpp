@@ -155,19 +155,55 @@ TEST(Untangling, LeavesAMeshWithoutCrossingsBitForBit) {
   EXPECT_EQ(positions_of(mesh), positions_of(before));
 }
 
-TEST(Untangling, IsDeterministicAndChecksItsOptions) {
-  TriMesh a = test::icosphere(1.0, 3);
-  pleat(a, 40, 3.0, 0.3);
-  ASSERT_GT(count_self_intersections(a), 0u);
-  TriMesh b = a;
-  untangle(a);
-  untangle(b);
-  EXPECT_EQ(positions_of(a), positions_of(b));
-  EXPECT_THROW(untangle(a, {.steps = 0}), Error);
-  EXPECT_THROW(untangle(a, {.fraction = 1.5}), Error);
-  EXPECT_THROW(untangle(a, {.max_rounds = -1}), Error);
-  TriMesh c = b;
-  EXPECT_EQ(untangle(c, {.max_rounds = 0}).rounds, 0);  // disabled
+TEST(Untangling, NeverMovesBoundaryVertices) {
+  // An icosphere opened around a vertex two rings from the pleat, so that the untangled region
+  // reaches the hole's rim.
+  const TriMesh closed = test::icosphere(1.0, 3);
+  const int pleated = 40;
+  std::set<int> ring1, ring2;
+  for (auto w : closed.vv_range(TriMesh::VertexHandle(pleated))) ring1.insert(w.idx());
+  for (int v : ring1)
+    for (auto w : closed.vv_range(TriMesh::VertexHandle(v)))
+      if (w.idx() != pleated && !ring1.count(w.idx())) ring2.insert(w.idx());
+  const int removed = *ring2.begin();
+  IndexedMesh indexed = make_icosphere(1.0, 3);
+  std::erase_if(indexed.triangles, [&](const auto& t) { return std::find(t.begin(), t.end(), removed) != t.end(); });
+  TriMesh mesh = test::to_trimesh(indexed);
+  pleat(mesh, pleated, 2.5, 0.4);
+  const TriMesh before = mesh;
+  const std::size_t crossing = count_self_intersections(mesh);
+  ASSERT_GT(crossing, 0u);
+
+  const UntanglingResult r = untangle(mesh);
+  std::printf("[measured] open sphere: %zu -> %zu crossing pairs in %d rounds\n", r.crossing_pairs_before,
+              r.crossing_pairs_after, r.rounds);
+  std::size_t boundary = 0, boundary_in_reach = 0;
+  const std::set<int> reach = near(before, self_intersecting_pairs(before), UntanglingOptions{}.ring + r.rounds);
+  for (auto v : mesh.vertices()) {
+    if (!mesh.is_boundary(v)) continue;
+    ++boundary;
+    boundary_in_reach += reach.count(v.idx());
+    EXPECT_EQ(mesh.point(v), before.point(v)) << v.idx();
+  }
+  EXPECT_GT(boundary, 0u);
+  EXPECT_GT(boundary_in_reach, 0u);  // the test would pass trivially if the rim were out of reach
+  EXPECT_LT(r.crossing_pairs_after, r.crossing_pairs_before);
+}
+
+TEST(Untangling, ChecksItsOptionsAndZeroRoundsChangesNothing) {
+  TriMesh mesh = test::icosphere(1.0, 3);
+  pleat(mesh, 40, 3.0, 0.3);
+  ASSERT_GT(count_self_intersections(mesh), 0u);
+  const TriMesh before = mesh;
+  const UntanglingResult none = untangle(mesh, {.max_rounds = 0});
+  EXPECT_EQ(none.rounds, 0);
+  EXPECT_EQ(none.crossing_pairs_after, none.crossing_pairs_before);
+  EXPECT_GT(none.crossing_pairs_before, 0u);
+  EXPECT_EQ(positions_of(mesh), positions_of(before));
+  EXPECT_THROW(untangle(mesh, {.steps = 0}), Error);
+  EXPECT_THROW(untangle(mesh, {.fraction = 1.5}), Error);
+  EXPECT_THROW(untangle(mesh, {.max_rounds = -1}), Error);
+  EXPECT_THROW(untangle(mesh, {.ring = -1}), Error);
 }
 
 }  // namespace

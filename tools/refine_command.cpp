@@ -158,7 +158,7 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   fmt::print("refined    {} → {} vertices in {} iterations, {:.2f} s ({})\n", s.initial_vertices, s.final_vertices,
              s.iterations.size(), s.seconds, to_string(s.status));
   fmt::print("Σg/vertex  {:.6g} → {:.6g}\n", s.initial_sum_g_per_vertex, s.final_sum_g_per_vertex);
-  fmt::print("mesh       {} ({} self-intersecting face pairs; {} untangled during the run)\n", args.output,
+  fmt::print("mesh       {} ({} self-intersecting face pairs; {} removed by untangling during the run)\n", args.output,
              s.self_intersections, s.untangled_pairs);
   if (!args.report.empty()) fmt::print("report     {}\n", args.report);
   return kOk;
@@ -216,7 +216,7 @@ void add_refine_command(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   c->add_option("--refine-min-growth", o.adaptive.min_growth,
                 "A refinement that would add fewer than this fraction of the vertices is not done (coarse to fine, "
-                "the run then ends converged; thesis preset: 0)")
+                "the run then ends; thesis preset: 0)")
       ->capture_default_str();
   c->add_option("--refine-when", args->refine_when,
                 "Adaptive refinement before every iteration (the thesis) or when the flow has converged at the "
