@@ -53,6 +53,12 @@ void IterationData::reset_topology() {
   previous_g_per_vertex = 0.0;
 }
 
+void IterationData::set_edge_lengths(const EdgeLengths& edges) {
+  shortest_edge = edges.shortest;
+  mean_edge = edges.mean;
+  sample_spacing = photo.sample_spacing(edges.shortest);
+}
+
 void IterationData::refit() {
   if (cancelled()) return;
   StageTimer timer(serial_seconds[static_cast<int>(Stage::Refit)]);

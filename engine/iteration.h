@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "engine/mesh.h"
+#include "engine/mesh_stats.h"
 #include "engine/refine_options.h"
 #include "engine/refine_report.h"
 #include "engine/surface_query.h"
@@ -45,10 +46,10 @@ struct IterationData {
   std::vector<double> moved;                     //!< length of each vertex's move this iteration
   std::vector<std::array<double, kStageCount>> block_seconds;  //!< per block, per stage
 
-  // Set before the iteration runs.
+  // Set before the iteration runs (set_edge_lengths).
   double shortest_edge = 0.0;
   double mean_edge = 0.0;
-  double sample_spacing = 0.0;
+  double sample_spacing = 0.0;  //!< Δx of the gradient's samples, from the shortest edge
   bool refit_needed = false;
   // Set by the CFL kernel.
   BlockPartial total;
@@ -67,6 +68,7 @@ struct IterationData {
   bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
 
   // The kernels. `block` indexes `blocks`.
+  void set_edge_lengths(const EdgeLengths& edges);  //!< e_min, the mean edge and Δx, before an iteration
   void refit();                        //!< serial: Embree refit to the current positions
   void geometry(std::size_t block);    //!< N and H
   void visibility(std::size_t block);  //!< visible views

@@ -35,8 +35,8 @@ MeshStats compute_mesh_stats(const Mesh& mesh) {
   for (auto e : m.edges()) s.boundary_edges += m.is_boundary(e);
 
   std::size_t used_vertices = 0;
+  s.bounding_box = bounding_box_of(m);
   for (auto v : m.vertices()) {
-    s.bounding_box.extend(to_eigen(m.point(v)));
     if (m.is_isolated(v)) {
       ++s.isolated_vertices;
       continue;
@@ -81,6 +81,12 @@ MeshStats compute_mesh_stats(const Mesh& mesh) {
   s.genus = (2 * static_cast<long>(s.components) - s.euler_characteristic -
              static_cast<long>(s.boundary_loops)) / 2;
   return s;
+}
+
+BoundingBox bounding_box_of(const TriMesh& mesh) {
+  BoundingBox box;
+  for (auto v : mesh.vertices()) box.extend(to_eigen(mesh.point(v)));
+  return box;
 }
 
 }  // namespace mvflow

@@ -38,4 +38,7 @@ struct EdgeLengths {
 };
 EdgeLengths edge_lengths(const TriMesh& mesh);
 
+//! The axis-aligned box of every vertex (isolated ones included); empty for a mesh without vertices.
+BoundingBox bounding_box_of(const TriMesh& mesh);
+
 }  // namespace mvflow

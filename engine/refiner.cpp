@@ -11,7 +11,6 @@
 #include <optional>
 #include <span>
 
-#include "engine/bounding_box.h"
 #include "engine/error.h"
 #include "engine/iteration.h"
 #include "engine/iteration_graph.h"
@@ -80,8 +79,8 @@ SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>&
     for (std::uint32_t v = block.begin; v < block.end; ++v) {
       const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
       Eigen::Vector3d colour = Eigen::Vector3d::Zero();
-      for (std::uint16_t k = 0; k < fields.visible_count[v]; ++k) {
-        const PhotoView& view = views[fields.visible_views[v * fields.view_capacity + k]];
+      for (const std::uint16_t id : fields.visible(v)) {
+        const PhotoView& view = views[id];
         const Projection p = view.project(P);
         colour += view.image->sample_bilinear(p.u, p.v).cast<double>();
       }
@@ -147,9 +146,7 @@ class Refinement {
         graph_.reset();
       }
       const EdgeLengths edges = edge_lengths(mesh_);
-      data_.shortest_edge = edges.shortest;
-      data_.mean_edge = edges.mean;
-      data_.sample_spacing = data_.photo.sample_spacing(edges.shortest);
+      data_.set_edge_lengths(edges);
       std::fill(std::begin(data_.serial_seconds), std::end(data_.serial_seconds), 0.0);
       for (auto& slots : data_.block_seconds) slots.fill(0.0);
 
@@ -163,7 +160,6 @@ class Refinement {
         status = RefineStatus::Cancelled;
         break;
       }
-      crossings_known_ = false;  // the surface moved
       fill_report(report, edges, refinement_seconds, iteration_start);
       StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move, data_.total.defined_g);
       report.stop = to_string(reason);
@@ -181,14 +177,17 @@ class Refinement {
     }
 
     progress(static_cast<int>(summary.iterations.size()), "finishing");
-    if (status != RefineStatus::Cancelled && !crossings_known_) untangle_folds();
+    const std::optional<UntanglingResult> untangled =
+        status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
     summary.untangled_pairs = untangled_pairs_;
     const SurfaceState final_state = evaluate_surface(mesh_, views_, options_);
     summary.status = status;
     summary.final_vertices = mesh_.n_vertices();
     summary.final_faces = mesh_.n_faces();
     summary.final_sum_g_per_vertex = final_state.sum_g_per_vertex;
-    summary.self_intersections = crossings_known_ ? crossings_left_ : count_self_intersections(mesh_);
+    // The untangling's last count holds unless the silhouette constraint cut its moves short.
+    const bool counted = untangled && !(inside_ && untangled->rounds > 0);
+    summary.self_intersections = counted ? untangled->crossing_pairs_after : count_self_intersections(mesh_);
     result.mesh.topology = mesh_;
     result.mesh.quality = final_state.g;
     result.mesh.colors = final_state.colours;
@@ -213,37 +212,32 @@ class Refinement {
   // regularization pass over the whole mesh.
   void prepare() {
     reference_edge_ = edge_lengths(mesh_).shortest;
-    BoundingBox box;
-    for (auto v : mesh_.vertices()) box.extend(to_eigen(mesh_.point(v)));
-    pixel_size_ = finest_pixel_size(views_, box.centre());
+    pixel_size_ = finest_pixel_size(views_, bounding_box_of(mesh_).centre());
     if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
     if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
     apply_smoothing(mesh_, options_.smoothing);
     apply_regularization(mesh_, options_.regularization);
   }
 
-  // Removes the folds of the current surface (UntanglingOptions); counted for the summary.
-  // True when it moved vertices.
-  bool untangle_folds() {
-    if (options_.untangling.max_rounds == 0) return false;
+  // Removes the folds of the current surface (UntanglingOptions), counted for the summary;
+  // nothing (nullopt) when the untangling is disabled.
+  std::optional<UntanglingResult> untangle_folds() {
+    if (options_.untangling.max_rounds == 0) return std::nullopt;
     const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const UntanglingResult result = untangle(mesh_, options_.untangling);
     untangled_pairs_ += result.crossing_pairs_before - result.crossing_pairs_after;
-    crossings_known_ = true;
-    crossings_left_ = result.crossing_pairs_after;
     if (inside_ && result.rounds > 0) {  // the silhouette constraint holds for these moves too
       for (auto v : mesh_.vertices()) {
         const Eigen::Vector3d& from = before[static_cast<std::size_t>(v.idx())];
         const Eigen::Vector3d to = to_eigen(mesh_.point(v));
         if (to != from) mesh_.set_point(v, to_openmesh(inside_->limit_move(from, to)));
       }
-      crossings_known_ = false;  // a limited move may have kept a crossing
     }
     if (control_.logger && result.crossing_pairs_before > 0)
       control_.logger->info("untangled {} crossing face pairs ({} left) by smoothing {} vertices in {} rounds",
                             result.crossing_pairs_before, result.crossing_pairs_after, result.smoothed_vertices,
                             result.rounds);
-    return result.rounds > 0;
+    return result;
   }
 
   // Normals and curvature at the current positions for every vertex (after the untangling moved
@@ -264,9 +258,7 @@ class Refinement {
     report.refined_faces += mesh_.n_faces() - faces;
     report.declined_vertices += result.declined;
     seconds += seconds_since(start);
-    if (mesh_.n_faces() == faces) return false;
-    crossings_known_ = false;  // new faces, new ids
-    return true;
+    return mesh_.n_faces() != faces;
   }
 
   // The coarse-to-fine schedule: when the flow has settled at this resolution, refine; true when
@@ -275,7 +267,8 @@ class Refinement {
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     if (reason != StopReason::Converged && reason != StopReason::StepSmall) return false;
     const auto start = Clock::now();
-    if (untangle_folds()) update_curvature();  // so that the marks do not follow a removed fold
+    const std::optional<UntanglingResult> untangled = untangle_folds();
+    if (untangled && untangled->rounds > 0) update_curvature();  // so the marks do not follow a removed fold
     double seconds = seconds_since(start);
     const bool refined = adapt(report, seconds);
     report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
@@ -327,10 +320,6 @@ class Refinement {
   double reference_edge_ = 0.0;
   double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
   std::size_t untangled_pairs_ = 0;
-  //! True when crossings_left_ counts the crossing face pairs of the current positions (set by
-  //! untangle_folds, cleared by every iteration), so that they are not searched twice.
-  bool crossings_known_ = false;
-  std::size_t crossings_left_ = 0;
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
   std::optional<SilhouetteConstraint> inside_;
 };

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace mvflow {
@@ -38,6 +39,10 @@ struct VertexFields {
   std::size_t view_capacity = 0;
 
   std::size_t size() const { return defined.size(); }
+  //! The visible views of vertex \p v (ids into the view list), in the order visibility found them.
+  std::span<const std::uint16_t> visible(std::size_t v) const {
+    return {visible_views.data() + v * view_capacity, visible_count[v]};
+  }
   //! Sizes every array for \p n_vertices and \p n_views (contents reset to zero).
   void resize(std::size_t n_vertices, std::size_t n_views);
 };

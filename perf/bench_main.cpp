@@ -47,9 +47,11 @@ Row row_of(const Measurement& m) {
   row["refine_s"] = m.refine_seconds;
   row["refine_iterations"] = m.refine_iterations;
   row["refine_vertices"] = m.refine_vertices;
+  row["refine_status"] = m.refine_status;
   row["g_start"] = m.initial_g_per_vertex;
   row["g_end"] = m.final_g_per_vertex;
   row["peak_MB"] = static_cast<double>(m.peak_bytes) / (1 << 20);
+  row["peak_reset"] = m.peak_reset;
   row["load"] = load_average();
   return row;
 }

@@ -55,7 +55,6 @@ Measurement measure(const BenchScene& scene, const RunConfig& config, const RunS
   MVFLOW_CHECK(settings.timed_iterations >= 6 && settings.refine_iterations >= 6, "at least 6 iterations");
   Measurement m;
   m.scene = scene.spec.label();
-  m.spec = scene.spec;
   m.config = config;
   release_free_memory();
   m.peak_reset = reset_peak_memory();

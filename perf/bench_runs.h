@@ -32,7 +32,6 @@ struct RunConfig {
 
 struct Measurement {
   std::string scene;  //!< SceneSpec::label()
-  SceneSpec spec;
   RunConfig config;
   // Fixed topology: means over the timed iterations after the first.
   double iteration_seconds = 0;                    //!< wall time

@@ -66,12 +66,8 @@ BenchScene make_bench_scene(const SceneSpec& spec) {
   options.init.amount = spec.init_offset;
   BenchScene result;
   result.spec = spec;
-  result.truth = make_builtin_object("bumpy-sphere", shape);
-  SynthScene synth = make_synth_scene(result.truth, nullptr, options);
-  result.scene.views = synth.views;
-  result.scene.images = std::make_shared<ImageStore>(synth.views.size(), nullptr);
-  for (std::size_t i = 0; i < synth.images.size(); ++i) result.scene.images->set(i, std::move(synth.images[i]));
-  result.scene.bounding_box = synth.bounding_box;
+  SynthScene synth = make_synth_scene(make_builtin_object("bumpy-sphere", shape), nullptr, options);
+  result.scene = in_memory_scene(std::move(synth.views), std::move(synth.images), synth.bounding_box);
   result.initial = build_mesh(synth.initial, "initial");
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

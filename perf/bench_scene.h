@@ -31,8 +31,7 @@ struct SceneSpec {
 struct BenchScene {
   SceneSpec spec;
   Scene scene;          //!< views, images (in the store), bounding box
-  Mesh initial;         //!< the initial mesh
-  IndexedMesh truth;    //!< the ground truth
+  Mesh initial;         //!< the initial mesh (the truth itself is not kept: it would count in peak memory)
   double seconds = 0;   //!< how long rendering and decimation took
 };
 

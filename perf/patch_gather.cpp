@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "stages/photo_consistency.h"
+
 namespace mvflow::perf {
 
 std::vector<PatchBlock> gradient_patch_blocks(const std::vector<Eigen::Vector3d>& points,
@@ -20,14 +22,10 @@ std::vector<PatchBlock> gradient_patch_blocks(const std::vector<Eigen::Vector3d>
         blocks.push_back({view.image->data() + y0 * stride + x0 * 3, stride});
       }
     };
-    add_sample(points[p]);
-    for (int axis = 0; axis < 3; ++axis)
-      for (int s = -half; s <= half; ++s) {
-        if (s == 0) continue;
-        Eigen::Vector3d X = points[p];
-        X[axis] += s * spacing;
-        add_sample(X);
-      }
+    for_each_gradient_sample(points[p], spacing, half, [&](std::size_t, const Eigen::Vector3d& X) {
+      add_sample(X);
+      return true;
+    });
   }
   return blocks;
 }

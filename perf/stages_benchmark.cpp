@@ -69,10 +69,6 @@ const VertexFields& visible_fields() {
   return cached;
 }
 
-std::span<const std::uint16_t> visible_of(const VertexFields& fields, std::size_t v) {
-  return {fields.visible_views.data() + v * fields.view_capacity, fields.visible_count[v]};
-}
-
 double sample_spacing() { return PhotoGradientStage().sample_spacing(scene().shortest_edge); }
 
 // The patch reads of the gradient stage (centre + 60 axis samples, usable views only).
@@ -84,7 +80,7 @@ const std::vector<perf::PatchBlock>& gradient_blocks() {
     std::vector<std::vector<std::uint16_t>> visible(s.n_vertices());
     for (std::size_t v = 0; v < s.n_vertices(); ++v) {
       points[v] = s.bench.initial.position(v);
-      const auto ids = visible_of(fields, v);
+      const auto ids = fields.visible(v);
       visible[v].assign(ids.begin(), ids.end());
       // The stage samples the axes only where g is defined at the vertex itself.
       if (!photo_consistency(points[v], ids, s.views).defined()) visible[v].clear();
@@ -140,7 +136,7 @@ void BM_PhotoConsistency(benchmark::State& state) {
   VertexFields fields = visible_fields();
   double view_samples = 0;
   for (std::size_t v = 0; v < s.n_vertices(); ++v)
-    view_samples += photo_consistency(s.bench.initial.position(v), visible_of(fields, v), s.views).views;
+    view_samples += photo_consistency(s.bench.initial.position(v), fields.visible(v), s.views).views;
   for (auto _ : state) compute_photo_consistency(s.mesh(), s.everything(), s.views, {}, fields);
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
   state.counters["patch_pixel_reads/s"] =
@@ -155,7 +151,8 @@ void BM_PhotoGradient(benchmark::State& state) {
   const PhotoGradientStage stage;
   const double evaluations = 3.0 * stage.options().savitzky_golay.k + 1;
   const double view_samples = static_cast<double>(gradient_blocks().size());
-  for (auto _ : state) stage.run(s.mesh(), s.everything(), s.views, sample_spacing(), fields);
+  const double spacing = sample_spacing();
+  for (auto _ : state) stage.run(s.mesh(), s.everything(), s.views, spacing, fields);
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
   const double runs = static_cast<double>(state.iterations());
   state.counters["g_evaluations/s"] =
@@ -181,9 +178,7 @@ BENCHMARK(BM_PatchGatherBound)->Unit(benchmark::kMillisecond);
 // What the refiner sets before an iteration runs: blocks and fields sized, the edge lengths and Δx.
 void prepare(IterationData& data, const StageScene& s) {
   data.reset_topology();
-  data.shortest_edge = s.shortest_edge;
-  data.mean_edge = s.mean_edge;
-  data.sample_spacing = sample_spacing();
+  data.set_edge_lengths({.shortest = s.shortest_edge, .mean = s.mean_edge});
 }
 
 // The serial reduction node: partials, Σg in id order, the quantile and median of |F|, Δt.

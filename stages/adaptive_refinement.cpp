@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "engine/bounding_box.h"
+#include "engine/mesh_stats.h"
 #include "engine/error.h"
 #include "stages/mesh_edit.h"
 #include "stages/one_ring.h"
@@ -31,12 +31,6 @@ std::array<HalfedgeHandle, 3> face_halfedges(const TriMesh& mesh, TriMesh::FaceH
   const HalfedgeHandle h0 = mesh.halfedge_handle(f);
   const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
   return {h0, h1, mesh.next_halfedge_handle(h1)};
-}
-
-double bounding_box_diagonal(const TriMesh& mesh) {
-  BoundingBox box;
-  for (auto v : mesh.vertices()) box.extend(detail::point(mesh, v));
-  return box.diagonal();
 }
 
 //! The red/green marks of one call: per face (1 = red) and per edge (1 = split), flat arrays
@@ -106,7 +100,7 @@ RefinementResult refine_adaptively(TriMesh& mesh, const VertexFields& fields, do
   Marks marks{std::vector<std::uint8_t>(mesh.n_faces(), 0), std::vector<std::uint8_t>(mesh.n_edges(), 0)};
   const double threshold = options.curvature_factor * reference_edge;
   const double min_edge =
-      std::max(options.min_edge_relative * bounding_box_diagonal(mesh), options.min_edge_pixels * pixel_size);
+      std::max(options.min_edge_relative * bounding_box_of(mesh).diagonal(), options.min_edge_pixels * pixel_size);
   result.marked_vertices = mark_red(mesh, fields, threshold, min_edge, marks);
   result.promoted_faces = close_red(mesh, marks);
   const auto split_edges = static_cast<std::size_t>(std::count(marks.split.begin(), marks.split.end(), 1));

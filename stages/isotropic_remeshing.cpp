@@ -127,16 +127,13 @@ void relax_and_project(TriMesh& mesh, const SurfaceQuery& reference) {
     for (std::size_t id = range.begin(); id < range.end(); ++id) {
       const VertexHandle v(static_cast<int>(id));
       const Eigen::Vector3d p = point(mesh, v);
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       int neighbours = 0;
       for (auto out = mesh.cvoh_iter(v); out.is_valid(); ++out) {
-        const Eigen::Vector3d q = point(mesh, mesh.to_vertex_handle(*out));
-        sum += q;
+        sum += point(mesh, mesh.to_vertex_handle(*out));
         ++neighbours;
-        if (!mesh.face_handle(*out).is_valid()) continue;
-        const Eigen::Vector3d r = point(mesh, mesh.to_vertex_handle(mesh.next_halfedge_handle(*out)));
-        normal += (q - p).cross(r - p);  // twice the area-weighted normal
       }
+      Eigen::Vector3d normal = detail::area_normal(mesh, v);  // twice the area-weighted normal
       Eigen::Vector3d target = p;
       if (neighbours > 0 && normal.norm() > 0.0) {
         normal.normalize();

@@ -1,6 +1,7 @@
 #pragma once
-// Renders a mesh into a camera with Embree: what `mvflow render` shows a user, and what the
-// held-out-view error compares with a photograph.
+// Renders a mesh into a camera with Embree, shaded or with its vertex colours: what
+// `mvflow render` shows a user. (The held-out-view error renders its own way: each ray's hit is
+// coloured from the other photographs, stages/heldout_error.h.)
 
 #include <cstdint>
 #include <vector>

@@ -77,10 +77,8 @@ void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const s
                                const PhotoConsistencyOptions& options, VertexFields& fields) {
   MVFLOW_CHECK(options.check(), "photo consistency options out of range");
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
-    const std::span<const std::uint16_t> visible(fields.visible_views.data() + v * fields.view_capacity,
-                                                 fields.visible_count[v]);
-    const PhotoValue value =
-        photo_consistency(to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))), visible, views, options);
+    const PhotoValue value = photo_consistency(to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))),
+                                               fields.visible(v), views, options);
     fields.photo_consistency[v] = value.defined() ? value.g : 0.0;
     if (value.defined())
       fields.defined[v] |= kPhotoDefined;

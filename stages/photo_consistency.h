@@ -41,4 +41,20 @@ PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint
 void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
                                const PhotoConsistencyOptions& options, VertexFields& fields);
 
+//! The points of the gradient's 6·half + 1 samples of g around \p X, in the slots the gradient
+//! stage reads: slot 0 = X, then X + s·spacing·e_a for a = x, y, z and s = −half..−1, 1..half.
+//! Calls visit(slot, point) in slot order while it returns true.
+template <class Visit>
+void for_each_gradient_sample(const Eigen::Vector3d& X, double spacing, int half, Visit visit) {
+  std::size_t slot = 0;
+  if (!visit(slot++, X)) return;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int s = -half; s <= half; ++s) {
+      if (s == 0) continue;
+      Eigen::Vector3d sample = X;
+      sample[axis] += s * spacing;
+      if (!visit(slot++, sample)) return;
+    }
+}
+
 }  // namespace mvflow

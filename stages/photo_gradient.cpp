@@ -21,16 +21,12 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
   const bool default_patch = options_.photo.half_patch == 2;
   // Buffers for the whole block: no allocation per vertex.
   std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
-  const auto visible_of = [&](std::uint32_t v) {
-    return std::span<const std::uint16_t>(fields.visible_views.data() + v * fields.view_capacity,
-                                          fields.visible_count[v]);
-  };
   const auto position = [&](std::uint32_t v) { return to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))); };
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
-    const std::span<const std::uint16_t> visible = visible_of(v);
+    const std::span<const std::uint16_t> visible = fields.visible(v);
     const Eigen::Vector3d X = position(v);
     // The next vertex's image blocks travel to the cache while this vertex's 61 samples run.
-    if (v + 1 < vertices.end && default_patch) detail::prefetch_patches(position(v + 1), visible_of(v + 1), views);
+    if (v + 1 < vertices.end && default_patch) detail::prefetch_patches(position(v + 1), fields.visible(v + 1), views);
     std::uint8_t& defined = fields.defined[v];
     defined &= static_cast<std::uint8_t>(~(kPhotoDefined | kGradientDefined));
     fields.photo_consistency[v] = 0.0;
@@ -41,15 +37,10 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     if (default_patch) {
       detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
     } else {
-      samples[0] = photo_consistency(X, visible, views, options_.photo);
-      std::size_t k = 1;
-      for (int axis = 0; axis < 3 && samples[0].defined(); ++axis)
-        for (int s = -half; s <= half; ++s) {
-          if (s == 0) continue;
-          Eigen::Vector3d sample = X;
-          sample[axis] += s * sample_spacing;
-          samples[k++] = photo_consistency(sample, visible, views, options_.photo);
-        }
+      for_each_gradient_sample(X, sample_spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
+        samples[slot] = photo_consistency(point, visible, views, options_.photo);
+        return samples[0].defined();
+      });
     }
     const PhotoValue centre = samples[0];
     if (!centre.defined()) continue;

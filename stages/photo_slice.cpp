@@ -41,8 +41,7 @@ PhotoSlice compute_photo_slice(const TriMesh& mesh, const std::vector<PhotoView>
                                const PhotoSliceOptions& options) {
   if (!options.check()) throw InputError("slice options out of range");
   if (mesh.n_faces() == 0) throw InputError("slice: the mesh has no faces");
-  BoundingBox box;
-  for (auto v : mesh.vertices()) box.extend(to_eigen(mesh.point(v)));
+  BoundingBox box = bounding_box_of(mesh);
   const Eigen::Vector3d grow = options.margin * box.size();
   box.min -= grow;
   box.max += grow;

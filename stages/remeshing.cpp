@@ -24,19 +24,6 @@ namespace {
 using VertexHandle = TriMesh::VertexHandle;
 using HalfedgeHandle = TriMesh::HalfedgeHandle;
 
-//! Σ (Q−P)×(R−P) over the faces (P, Q, R) around \p v: twice the area-weighted normal of its ring.
-Eigen::Vector3d area_normal(const TriMesh& mesh, VertexHandle v) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  const Eigen::Vector3d p = detail::point(mesh, v);
-  for (auto h = mesh.cvoh_iter(v); h.is_valid(); ++h) {
-    if (!mesh.face_handle(*h).is_valid()) continue;
-    const Eigen::Vector3d q = detail::point(mesh, mesh.to_vertex_handle(*h));
-    const Eigen::Vector3d r = detail::point(mesh, mesh.to_vertex_handle(mesh.next_halfedge_handle(*h)));
-    sum += (q - p).cross(r - p);
-  }
-  return sum;
-}
-
 enum class Verdict { Ok, FoldOver, LongEdge };
 
 //! Would moving both ends of the collapsed edge to \p target keep every surviving face around
@@ -111,7 +98,7 @@ void collapse_short_edges(TriMesh& mesh, double lower, double upper, RemeshingRe
     const Eigen::Vector3d target = (from_boundary || to_boundary)
                                        ? detail::point(mesh, to)
                                        : 0.5 * (detail::point(mesh, from) + detail::point(mesh, to));
-    const Eigen::Vector3d ring_normal = area_normal(mesh, from) + area_normal(mesh, to);
+    const Eigen::Vector3d ring_normal = detail::area_normal(mesh, from) + detail::area_normal(mesh, to);
     Verdict verdict = check_ring(mesh, from, to, target, ring_normal, upper);
     if (verdict == Verdict::Ok) verdict = check_ring(mesh, to, from, target, ring_normal, upper);
     if (verdict != Verdict::Ok) {

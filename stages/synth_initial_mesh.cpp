@@ -11,6 +11,7 @@
 
 #include "engine/bounding_box.h"
 #include "engine/error.h"
+#include "stages/mesh_cleanup.h"
 #include "stages/synth_render.h"
 #include "stages/synth_texture.h"
 
@@ -82,14 +83,6 @@ void require_closed_manifold(const IndexedMesh& mesh) {
   if (report.rejected_faces > 0) throw InputError("initial mesh: the ground truth is not manifold");
   for (const auto h : built.topology.halfedges())
     if (built.topology.is_boundary(h)) throw InputError("initial mesh: the ground truth is not closed (it has a boundary)");
-}
-
-// Signed volume of a closed, outward-oriented mesh (divergence theorem).
-double enclosed_volume(const IndexedMesh& mesh) {
-  double six_volume = 0.0;
-  for (const auto& t : mesh.triangles)
-    six_volume += mesh.positions[t[0]].dot(mesh.positions[t[1]].cross(mesh.positions[t[2]]));
-  return six_volume / 6.0;
 }
 
 double box_diagonal(const IndexedMesh& mesh) {

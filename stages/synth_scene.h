@@ -11,6 +11,7 @@
 #include "engine/camera.h"
 #include "engine/image.h"
 #include "engine/mesh.h"
+#include "engine/scene.h"
 #include "stages/synth_cameras.h"
 #include "stages/synth_initial_mesh.h"
 #include "stages/synth_objects.h"
@@ -62,6 +63,10 @@ struct SynthScene {
 //! not closed and manifold (initial mesh), or `Uv` albedo without texture.
 SynthScene make_synth_scene(const IndexedMesh& truth, std::shared_ptr<const Image> uv_texture,
                             const SynthOptions& options);
+
+//! A scene held in memory (no files behind it): \p views with their \p images (one each), for
+//! the refiner, tests and benchmarks that render instead of reading.
+Scene in_memory_scene(std::vector<View> views, std::vector<Image> images, const BoundingBox& bounding_box = {});
 
 //! The renderer make_synth_scene uses, exposed for tests and tools that render more views.
 SynthRenderer make_synth_renderer(const IndexedMesh& truth, std::shared_ptr<const Image> uv_texture,

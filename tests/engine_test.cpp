@@ -32,10 +32,7 @@ const SmallScene& small_scene() {
     SmallScene s;
     s.truth = make_builtin_object("bumpy-sphere", shape);
     SynthScene synth = make_synth_scene(s.truth, nullptr, options);
-    s.scene.views = synth.views;
-    s.scene.images = std::make_shared<ImageStore>(synth.views.size(), nullptr);
-    for (std::size_t i = 0; i < synth.images.size(); ++i) s.scene.images->set(i, std::move(synth.images[i]));
-    s.scene.bounding_box = synth.bounding_box;
+    s.scene = in_memory_scene(std::move(synth.views), std::move(synth.images), synth.bounding_box);
     s.initial = build_mesh(synth.initial, "initial");
     return s;
   }();

@@ -45,13 +45,7 @@ const SmallScene& small_scene() {
 }
 
 // A scene over \p images (the small scene's cameras).
-Scene make_scene(const std::vector<Image>& images) {
-  Scene scene;
-  scene.views = small_scene().views;
-  scene.images = std::make_shared<ImageStore>(images.size(), nullptr);
-  for (std::size_t i = 0; i < images.size(); ++i) scene.images->set(i, images[i]);
-  return scene;
-}
+Scene make_scene(const std::vector<Image>& images) { return in_memory_scene(small_scene().views, images); }
 
 Image noise_image(int width, int height, unsigned seed) {
   std::mt19937 random(seed);

@@ -296,9 +296,8 @@ TEST(Visibility, EqualsBruteForceWithAnOccluder) {
       }
       expected.push_back(i);
     }
-    const std::vector<std::uint16_t> found(fields.visible_views.begin() + v * fields.view_capacity,
-                                           fields.visible_views.begin() + v * fields.view_capacity +
-                                               fields.visible_count[v]);
+    const std::span<const std::uint16_t> visible = fields.visible(v);
+    const std::vector<std::uint16_t> found(visible.begin(), visible.end());
     EXPECT_EQ(found, expected) << "vertex " << v;
     visible_pairs += static_cast<int>(expected.size());
   }
@@ -464,9 +463,8 @@ TEST(PhotoConsistency, EqualsSlowReferenceOnARenderedObject) {
   double worst = 0, smallest = 1e300;
   int compared = 0;
   for (std::uint32_t v = 0; v < s.truth.n_vertices(); v += 2) {
-    const std::vector<std::uint16_t> visible(s.fields.visible_views.begin() + v * s.fields.view_capacity,
-                                             s.fields.visible_views.begin() + v * s.fields.view_capacity +
-                                                 s.fields.visible_count[v]);
+    const std::span<const std::uint16_t> visible_span = s.fields.visible(v);
+    const std::vector<std::uint16_t> visible(visible_span.begin(), visible_span.end());
     for (double t : {0.0, 1.0}) {
       const Eigen::Vector3d X = s.truth.position(v) + t * s.shortest_edge * s.fields.normal[v];
       const PhotoValue slow = slow_photo_consistency(X, s.cameras, s.images, visible);
@@ -495,8 +493,7 @@ TEST(PhotoConsistency, MinimumAlongTheNormalOnARenderedObject) {
   for (std::uint32_t v = 0; v < s.truth.n_vertices(); ++v) {
     if (s.fields.visible_count[v] < 2) continue;
     ++vertices;
-    const std::span<const std::uint16_t> visible(s.fields.visible_views.data() + v * s.fields.view_capacity,
-                                                 s.fields.visible_count[v]);
+    const std::span<const std::uint16_t> visible = s.fields.visible(v);
     const Eigen::Vector3d P = s.truth.position(v), N = s.fields.normal[v];
     int best = 0;
     double best_g = 1e300, g_low = 0, g_high = 0;
@@ -555,9 +552,8 @@ TEST(PhotoGradient, MatchesTheSlowReferenceOnARenderedObject) {
   int compared = 0;
   for (std::size_t p = 0; p < probes.n_vertices(); ++p) {
     if (!(fields.defined[p] & kGradientDefined)) continue;
-    const std::vector<std::uint16_t> visible(fields.visible_views.begin() + p * fields.view_capacity,
-                                             fields.visible_views.begin() + p * fields.view_capacity +
-                                                 fields.visible_count[p]);
+    const std::span<const std::uint16_t> visible_span = fields.visible(p);
+    const std::vector<std::uint16_t> visible(visible_span.begin(), visible_span.end());
     Eigen::Vector3d expected;
     for (int axis = 0; axis < 3; ++axis) {
       double derivative = 0;
