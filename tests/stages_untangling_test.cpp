@@ -71,9 +71,7 @@ Pairs brute_force_pairs(const TriMesh& mesh) {
 // and `inward` mean edges below it, so the fan of faces stretched behind it dives under the
 // faces it passed.
 void pleat(TriMesh& mesh, int v, double tangential, double inward) {
-  double edge = 0;
-  for (auto e : mesh.edges()) edge += mesh.calc_edge_length(e);
-  edge /= static_cast<double>(mesh.n_edges());
+  const double edge = test::edge_spread(mesh).mean;
   const Eigen::Vector3d p = test::position(mesh, static_cast<std::size_t>(v));
   const Eigen::Vector3d n = p.normalized();
   const Eigen::Vector3d t = n.cross(Eigen::Vector3d::UnitZ().cross(n).norm() > 0.1 ? Eigen::Vector3d::UnitZ()
