@@ -5,12 +5,15 @@
 # 0.040; `mvflow refine` (default options) is timed as a whole; the mean radial error of the
 # result is printed beside the peer's (OpenMVS RefineMesh, CPU, 2 threads: 37 s, 0.040 -> 0.0027).
 #
-#   perf/openmvs_case.sh [SCENE_DIR]        (THREADS=2 and MVFLOW=build/tools/mvflow by default)
+#   perf/openmvs_case.sh [SCENE_DIR [REFINE OPTIONS...]]   (THREADS=2, MVFLOW=build/tools/mvflow by default)
+#
+# REFINE OPTIONS go to `mvflow refine`, e.g. `perf/openmvs_case.sh /tmp/case --max-iterations 30`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mvflow=${MVFLOW:-build/tools/mvflow}
 threads=${THREADS:-2}
 scene=${1:-/tmp/mvflow-openmvs-case}
+refine_options=("${@:2}")
 
 # offset 0.011547 × the sphere's box diagonal (2√3) = 0.040
 [ -f "$scene/synth_par.txt" ] ||
@@ -19,7 +22,8 @@ scene=${1:-/tmp/mvflow-openmvs-case}
 
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 start=$(date +%s.%N)
-"$mvflow" --log-level warn refine "$scene" -o "$scene/refined.ply" --report "$scene/report.json" --threads "$threads"
+"$mvflow" --log-level warn refine "$scene" -o "$scene/refined.ply" --report "$scene/report.json" --threads "$threads" \
+  "${refine_options[@]}"
 end=$(date +%s.%N)
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
 
