@@ -527,6 +527,18 @@ TEST(PhotoConsistency, MinimumAlongTheNormalOnARenderedObject) {
   EXPECT_GE(rising, 0.9 * vertices);
 }
 
+// Fields for probe points near truth vertices: probe p sees the views of vertex source[p].
+VertexFields probe_fields(const SphereScene& s, const std::vector<std::uint32_t>& source) {
+  VertexFields fields;
+  fields.resize(source.size(), s.views.size());
+  for (std::size_t p = 0; p < source.size(); ++p) {
+    const std::span<const std::uint16_t> visible = s.fields.visible(source[p]);
+    fields.visible_count[p] = static_cast<std::uint16_t>(visible.size());
+    std::copy(visible.begin(), visible.end(), fields.visible_views.begin() + p * fields.view_capacity);
+  }
+  return fields;
+}
+
 TEST(PhotoGradient, MatchesTheSlowReferenceOnARenderedObject) {
   // ∇g of the stage (float interpolation, samples projected linearly in s) against the same
   // Savitzky–Golay sum over the double-precision reference at each sample point.
@@ -540,13 +552,7 @@ TEST(PhotoGradient, MatchesTheSlowReferenceOnARenderedObject) {
     probes.topology.add_vertex(to_openmesh(s.truth.position(v) + 0.5 * s.shortest_edge * s.fields.normal[v]));
     source.push_back(v);
   }
-  VertexFields fields;
-  fields.resize(probes.n_vertices(), s.views.size());
-  for (std::size_t p = 0; p < probes.n_vertices(); ++p) {
-    fields.visible_count[p] = s.fields.visible_count[source[p]];
-    std::copy_n(s.fields.visible_views.begin() + source[p] * s.fields.view_capacity, fields.visible_count[p],
-                fields.visible_views.begin() + p * fields.view_capacity);
-  }
+  VertexFields fields = probe_fields(s, source);
   stage.run(probes.topology, {0, static_cast<std::uint32_t>(probes.n_vertices())}, s.views, dx, fields);
   double worst = 0;
   int compared = 0;
@@ -591,13 +597,7 @@ TEST(PhotoGradient, PointsAwayFromARenderedObject) {
       side.push_back(t);
     }
   }
-  VertexFields fields;
-  fields.resize(probes.n_vertices(), s.views.size());
-  for (std::size_t p = 0; p < probes.n_vertices(); ++p) {
-    fields.visible_count[p] = s.fields.visible_count[source[p]];
-    std::copy_n(s.fields.visible_views.begin() + source[p] * s.fields.view_capacity, fields.visible_count[p],
-                fields.visible_views.begin() + p * fields.view_capacity);
-  }
+  VertexFields fields = probe_fields(s, source);
   stage.run(probes.topology, {0, static_cast<std::uint32_t>(probes.n_vertices())}, s.views,
             stage.sample_spacing(s.shortest_edge), fields);
   int defined = 0, away = 0;
