@@ -10,8 +10,10 @@
 #include "stages/commit.h"
 #include "stages/curvature.h"
 #include "stages/normals.h"
+#include "stages/photo_robust.h"
 #include "stages/regularization.h"
 #include "stages/smoothing.h"
+#include "stages/unobserved_speed.h"
 #include "stages/visibility.h"
 
 namespace mvflow {
@@ -78,6 +80,7 @@ void IterationData::visibility(std::size_t block) {
   if (cancelled()) return;
   StageTimer timer(block_seconds[block][static_cast<int>(Stage::Visibility)]);
   compute_visibility(mesh, blocks[block], views, *surface, mean_edge, options.visibility, fields);
+  drop_outlier_views(mesh, blocks[block], views, options.photo.photo, fields);
 }
 
 void IterationData::photo_speed(std::size_t block) {
@@ -119,6 +122,8 @@ void IterationData::cfl() {
                                   : MoveLimit{.distance = cfl_fraction * shortest_edge};
   moving = 0;
   for (std::uint8_t bits : fields.defined) moving += (bits & kSpeedDefined) != 0;
+  // After Δt: the step is set by what the photographs say, the filled speeds only follow it.
+  fill_unobserved_speeds(mesh, options.unobserved, fields);
 }
 
 void IterationData::measure_moves() {
@@ -155,6 +160,12 @@ void IterationData::smooth(std::size_t block) {
   smooth_curvature_normal(mesh, blocks[block], options.smoothing, new_positions);
 }
 
+void IterationData::inflate(std::size_t block) {
+  if (cancelled()) return;
+  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Smoothing)]);
+  inflate_curvature_normal(mesh, blocks[block], options.smoothing, new_positions);
+}
+
 void IterationData::regularize(std::size_t block) {
   if (cancelled()) return;
   StageTimer timer(block_seconds[block][static_cast<int>(Stage::Regularization)]);
@@ -178,6 +189,10 @@ void run_iteration_sequential(IterationData& data) {
   for (int step = 0; step < data.options.smoothing.steps; ++step) {
     for (std::size_t b = 0; b < n; ++b) data.smooth(b);
     for (std::size_t b = 0; b < n; ++b) data.commit(b);
+    if (data.options.smoothing.taubin_pass_band > 0.0) {
+      for (std::size_t b = 0; b < n; ++b) data.inflate(b);
+      for (std::size_t b = 0; b < n; ++b) data.commit(b);
+    }
   }
   for (int step = 0; step < data.options.regularization.steps; ++step) {
     for (std::size_t b = 0; b < n; ++b) data.regularize(b);

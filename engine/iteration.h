@@ -80,6 +80,7 @@ struct IterationData {
   void move(std::size_t block);        //!< P ← P + Δt·F
   void measure_moves();                //!< serial, after the iteration: median_move
   void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
+  void inflate(std::size_t block);     //!< new position of Taubin's second step (taubin_pass_band > 0)
   void regularize(std::size_t block);  //!< normals at the current positions, then regularization
   void commit(std::size_t block);      //!< new positions into the mesh
 };

@@ -44,6 +44,10 @@ IterationGraph::IterationGraph(IterationData& data) : n_blocks_(data.blocks.size
   for (int step = 0; step < data.options.smoothing.steps; ++step) {
     last = phase(last, &IterationData::smooth);
     last = phase(last, &IterationData::commit);
+    if (data.options.smoothing.taubin_pass_band > 0.0) {
+      last = phase(last, &IterationData::inflate);
+      last = phase(last, &IterationData::commit);
+    }
   }
   for (int step = 0; step < data.options.regularization.steps; ++step) {
     last = phase(last, &IterationData::regularize);

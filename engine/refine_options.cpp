@@ -8,12 +8,14 @@ void RefineOptions::check() const {
   auto require = [](bool ok, const char* what) {
     if (!ok) throw InputError(std::string("option out of range: ") + what);
   };
-  require(visibility.check(), "visibility (max angle in (0, 90], patch, ray offset)");
-  require(photo.check(), "photo consistency / Savitzky-Golay (k even >= 2, order, patch 1..7)");
+  require(visibility.check(), "visibility (max angle in (0, 90], patch, ray offset, max views 0 or >= 2)");
+  require(photo.check(), "photo consistency / Savitzky-Golay (k even >= 2, order, patch 1..7, noise floor in [0, 1], "
+                         "drop views 0..64, min views >= 2)");
+  require(unobserved.check(), "unobserved speed (rings >= 1)");
   require(speed.check(), "velocity");
   require(cfl > 0 && cfl <= 10, "cfl (0, 10]");
   require(speed_quantile > 0 && speed_quantile <= 1, "speed quantile (0, 1]");
-  require(smoothing.check(), "smoothing (lambda*dt in (0,1), steps >= 0)");
+  require(smoothing.check(), "smoothing (lambda*dt in (0,1), steps >= 0, Taubin pass band >= 0 with mu < 1)");
   require(regularization.check(), "regularization (strength in (0,1], steps >= 0)");
   require(stopping.check(), "stopping (epsilon, iterations, lookback, tolerance)");
   require(remeshing.check(), "remeshing factors");
@@ -38,6 +40,7 @@ RefineOptions thesis_preset() {
   options.adaptive.min_edge_pixels = 0.0;
   options.adaptive.min_growth = 0.0;
   options.untangling.max_rounds = 0;
+  options.smoothing.taubin_pass_band = 0.0;
   options.refinement_schedule = RefinementSchedule::EveryIteration;
   options.stopping.test = ConvergenceTest::EachLookback;
   return options;

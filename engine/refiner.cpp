@@ -19,6 +19,7 @@
 #include "stages/curvature.h"
 #include "stages/normals.h"
 #include "stages/photo_consistency.h"
+#include "stages/photo_robust.h"
 #include "stages/regularization.h"
 #include "stages/remeshing.h"
 #include "stages/self_intersections.h"
@@ -75,6 +76,7 @@ SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>&
     const IndexRange block = blocks[b];
     compute_normals(mesh, block, fields);
     compute_visibility(mesh, block, views, surface, mean_edge, options.visibility, fields);
+    drop_outlier_views(mesh, block, views, options.photo.photo, fields);
     compute_photo_consistency(mesh, block, views, options.photo.photo, fields);
     for (std::uint32_t v = block.begin; v < block.end; ++v) {
       const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));

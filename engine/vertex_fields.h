@@ -19,6 +19,9 @@ enum VertexDefined : std::uint8_t {
   kPhotoDefined = 1u << 2,     //!< g is defined (≥ 2 usable views)
   kGradientDefined = 1u << 3,  //!< every one of the 3k+1 samples had ≥ 2 views
   kSpeedDefined = 1u << 4,
+  //! F was not observed (no defined g or ∇g) but taken from observed neighbours
+  //! (stages/unobserved_speed.h): the vertex moves, the step size and stopping rules ignore it.
+  kSpeedFilled = 1u << 5,
 };
 
 struct VertexFields {

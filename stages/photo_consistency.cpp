@@ -6,6 +6,7 @@
 
 #include "engine/error.h"
 #include "stages/photo_kernel.h"
+#include "stages/photo_robust.h"
 
 namespace mvflow {
 
@@ -69,6 +70,10 @@ PhotoValue photo_consistency_any(const Eigen::Vector3d& X, std::span<const std::
 
 PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                              const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options) {
+  if (options.normalize) {
+    const std::vector<ViewGainBias> maps = gain_bias_at(X, view_ids, views, options.half_patch, options.noise_floor);
+    return normalized_photo_consistency(X, view_ids, maps, views, options.half_patch);
+  }
   if (options.half_patch == 2) return detail::photo_consistency_5x5(X, view_ids, views);
   return photo_consistency_any(X, view_ids, views, options.half_patch);
 }

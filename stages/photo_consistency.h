@@ -22,7 +22,21 @@ namespace mvflow {
 
 struct PhotoConsistencyOptions {
   int half_patch = 2;  //!< patch of (2·half_patch+1)² pixels; 2 = the thesis's 5×5 (range 1..7)
-  bool check() const { return half_patch >= 1 && half_patch <= 7; }
+  //! Per-view gain/bias normalisation of the patches before the variance (stages/photo_robust.h):
+  //! exposure and lighting that differ between photographs no longer count as inconsistency.
+  //! false: the thesis's g on raw colours.
+  bool normalize = false;
+  //! σ₀ of the normalisation on [0,1] values, ≥ 0: patches with less contrast than this are not
+  //! stretched to unit contrast (their noise would be). 0.02 ≈ 5 grey levels of 8-bit photos.
+  double noise_floor = 0.02;
+  //! Up to this many outlier views are removed from a vertex's view set (stages/photo_robust.h)
+  //! while more than min_views remain; 0 keeps every view (the thesis).
+  int drop_views = 0;
+  int min_views = 4;  //!< views kept at least when dropping outliers (≥ 2)
+  bool check() const {
+    return half_patch >= 1 && half_patch <= 7 && noise_floor >= 0 && noise_floor <= 1 && drop_views >= 0 &&
+           drop_views <= 64 && min_views >= 2;
+  }
 };
 
 //! g at one point and the number of views that contributed.

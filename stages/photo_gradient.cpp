@@ -4,6 +4,7 @@
 
 #include "engine/error.h"
 #include "stages/photo_kernel.h"
+#include "stages/photo_robust.h"
 
 namespace mvflow {
 
@@ -18,7 +19,8 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
                              double sample_spacing, VertexFields& fields) const {
   MVFLOW_CHECK(sample_spacing > 0, "photo gradient: sample spacing must be positive");
   const int half = options_.savitzky_golay.half_window();
-  const bool default_patch = options_.photo.half_patch == 2;
+  const PhotoConsistencyOptions& photo = options_.photo;
+  const bool default_patch = photo.half_patch == 2 && !photo.normalize;
   // Buffers for the whole block: no allocation per vertex.
   std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
   const auto position = [&](std::uint32_t v) { return to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))); };
@@ -36,6 +38,13 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     // shared by the axes).
     if (default_patch) {
       detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
+    } else if (photo.normalize) {
+      // One map per view, taken at X, for every sample: g stays smooth along the sample lines.
+      const std::vector<ViewGainBias> maps = gain_bias_at(X, visible, views, photo.half_patch, photo.noise_floor);
+      for_each_gradient_sample(X, sample_spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
+        samples[slot] = normalized_photo_consistency(point, visible, maps, views, photo.half_patch);
+        return samples[0].defined();
+      });
     } else {
       for_each_gradient_sample(X, sample_spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
         samples[slot] = photo_consistency(point, visible, views, options_.photo);

@@ -8,12 +8,14 @@
 namespace mvflow {
 
 bool SmoothingOptions::check() const {
-  return lambda_dt > 0.0 && lambda_dt < 1.0 && steps >= 0;
+  return lambda_dt > 0.0 && lambda_dt < 1.0 && steps >= 0 && taubin_pass_band >= 0.0 && taubin_mu() < 1.0;
 }
 
-void smooth_curvature_normal(const TriMesh& mesh, IndexRange vertices, const SmoothingOptions& options,
-                             std::vector<Eigen::Vector3d>& new_positions) {
-  MVFLOW_CHECK(options.check(), "smooth_curvature_normal: invalid SmoothingOptions");
+namespace {
+
+// P' = P + factor·(centroid − P) for the vertices of the range (smooth_curvature_normal).
+void step_toward_centroid(const TriMesh& mesh, IndexRange vertices, double factor,
+                          std::vector<Eigen::Vector3d>& new_positions) {
   detail::check_range(vertices, mesh.n_vertices(), "smooth_curvature_normal");
   MVFLOW_CHECK(new_positions.size() == mesh.n_vertices(),
                "smooth_curvature_normal: buffer is not sized for the mesh");
@@ -30,8 +32,22 @@ void smooth_curvature_normal(const TriMesh& mesh, IndexRange vertices, const Smo
     // use the uniform centroid, which always lies inside the one ring.
     if (ring.degenerate || !(ring.weight_sum > 0.0) || !to_centroid.allFinite())
       to_centroid = ring.uniform_difference / ring.neighbours;
-    new_positions[id] = p + options.lambda_dt * to_centroid;
+    new_positions[id] = p + factor * to_centroid;
   }
+}
+
+}  // namespace
+
+void smooth_curvature_normal(const TriMesh& mesh, IndexRange vertices, const SmoothingOptions& options,
+                             std::vector<Eigen::Vector3d>& new_positions) {
+  MVFLOW_CHECK(options.check(), "smooth_curvature_normal: invalid SmoothingOptions");
+  step_toward_centroid(mesh, vertices, options.lambda_dt, new_positions);
+}
+
+void inflate_curvature_normal(const TriMesh& mesh, IndexRange vertices, const SmoothingOptions& options,
+                              std::vector<Eigen::Vector3d>& new_positions) {
+  MVFLOW_CHECK(options.check() && options.taubin_pass_band > 0.0, "inflate_curvature_normal: invalid SmoothingOptions");
+  step_toward_centroid(mesh, vertices, -options.taubin_mu(), new_positions);
 }
 
 void apply_smoothing(TriMesh& mesh, const SmoothingOptions& options) {
@@ -41,6 +57,10 @@ void apply_smoothing(TriMesh& mesh, const SmoothingOptions& options) {
   for (int step = 0; step < options.steps; ++step) {
     smooth_curvature_normal(mesh, all, options, buffer);
     commit_positions(mesh, all, buffer);
+    if (options.taubin_pass_band > 0.0) {
+      inflate_curvature_normal(mesh, all, options, buffer);
+      commit_positions(mesh, all, buffer);
+    }
   }
 }
 

@@ -17,6 +17,14 @@ struct SmoothingOptions {
   double lambda_dt = 0.1;
   //! Smoothing steps per call of apply_smoothing (per flow iteration); ≥ 0, 0 disables.
   int steps = 1;
+  //! Taubin's pass-band frequency k_PB (λ|μ smoothing, SIGGRAPH 1995): after each step a second
+  //! one with the factor −μ, μ = λ·dt/(1 − k_PB·λ·dt), moves every vertex away from its
+  //! centroid, so the pair removes noise without shrinking the surface (plain steps shrink thin,
+  //! weakly textured parts away: README, "Defaults and differences"). 0.1, Taubin's usual value;
+  //! 0 = no second step (the thesis); in [0, 1/λ·dt − 1).
+  double taubin_pass_band = 0.1;
+  //! μ of the second step (0 when taubin_pass_band is 0).
+  double taubin_mu() const { return taubin_pass_band > 0.0 ? lambda_dt / (1.0 - taubin_pass_band * lambda_dt) : 0.0; }
 
   bool check() const;
 };
@@ -40,8 +48,14 @@ struct SmoothingOptions {
 void smooth_curvature_normal(const TriMesh& mesh, IndexRange vertices, const SmoothingOptions& options,
                              std::vector<Eigen::Vector3d>& new_positions);
 
-//! Runs options.steps steps of smooth_curvature_normal over the whole mesh, each computed into
-//! a buffer from the previous step's positions and then committed.
+//! The same step with the factor −options.taubin_mu() (away from the centroid): Taubin's second
+//! step. \pre options.taubin_pass_band > 0.
+void inflate_curvature_normal(const TriMesh& mesh, IndexRange vertices, const SmoothingOptions& options,
+                              std::vector<Eigen::Vector3d>& new_positions);
+
+//! Runs options.steps steps of smooth_curvature_normal (each followed by
+//! inflate_curvature_normal when taubin_pass_band > 0) over the whole mesh, each computed into a buffer
+//! from the previous step's positions and then committed.
 //! \param mesh    The surface, modified in place.
 //! \param options Checked with check().
 void apply_smoothing(TriMesh& mesh, const SmoothingOptions& options = {});

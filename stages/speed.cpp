@@ -22,7 +22,7 @@ void compute_speed(IndexRange vertices, const SpeedOptions& options, VertexField
   detail::check_range(vertices, fields.size(), "compute_speed");
   for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
     fields.speed[id] = Eigen::Vector3d::Zero();
-    fields.defined[id] &= static_cast<std::uint8_t>(~kSpeedDefined);
+    fields.defined[id] &= static_cast<std::uint8_t>(~(kSpeedDefined | kSpeedFilled));
     if ((fields.defined[id] & speed_inputs) != speed_inputs) continue;
     const Eigen::Vector3d& n = fields.normal[id];
     const double g = fields.photo_consistency[id];
@@ -90,7 +90,7 @@ void move_vertices(TriMesh& mesh, IndexRange vertices, const VertexFields& field
   for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
     const auto v = detail::handle(id);
     if (moved) (*moved)[id] = 0.0;
-    if (!(fields.defined[id] & kSpeedDefined) || mesh.is_boundary(v)) continue;
+    if (!(fields.defined[id] & (kSpeedDefined | kSpeedFilled)) || mesh.is_boundary(v)) continue;
     Eigen::Vector3d step = dt * fields.speed[id];
     double longest = limit.distance;
     if (limit.local_edge_fraction > 0.0) longest = std::min(longest, limit.local_edge_fraction * fields.local_edge[id]);

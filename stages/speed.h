@@ -70,7 +70,8 @@ struct MoveLimit {
   double local_edge_fraction = 0.0;  //!< × the shortest edge at the vertex; 0 = no local limit
 };
 
-//! The forward Euler update P ← P + dt·F(P) for every vertex in \p vertices with kSpeedDefined;
+//! The forward Euler update P ← P + dt·F(P) for every vertex in \p vertices with kSpeedDefined
+//! or kSpeedFilled;
 //! boundary vertices never move. Writes the positions of \p vertices only: the speed was
 //! computed from the old positions of every block, so run it after all blocks' speeds.
 //! \param mesh     The surface, #V vertices; positions of \p vertices are updated.

@@ -1,5 +1,6 @@
 #include "stages/visibility.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -14,6 +15,7 @@ void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vec
   MVFLOW_CHECK(fields.view_capacity >= views.size(), "vertex fields sized for fewer views");
   const double cos_max = std::cos(options.max_angle_degrees * std::numbers::pi / 180.0);
   const double offset = options.ray_offset * mean_edge;
+  std::vector<std::pair<double, std::uint16_t>> ranked;  // (−cos, view): the best first
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     std::uint16_t* visible = fields.visible_views.data() + v * fields.view_capacity;
     std::uint16_t count = 0;
@@ -32,6 +34,18 @@ void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vec
         const Eigen::Vector3d from_origin = view.camera->centre() - origin;
         if (surface.occluded(origin, from_origin, 0.0, 1.0)) continue;
         visible[count++] = static_cast<std::uint16_t>(i);
+      }
+      if (options.max_views > 0 && count > options.max_views) {
+        ranked.clear();
+        for (std::uint16_t k = 0; k < count; ++k) {
+          const Eigen::Vector3d to_camera = views[visible[k]].camera->centre() - P;
+          ranked.emplace_back(-N.dot(to_camera) / to_camera.norm(), visible[k]);
+        }
+        std::sort(ranked.begin(), ranked.end());
+        ranked.resize(static_cast<std::size_t>(options.max_views));
+        std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+        count = static_cast<std::uint16_t>(options.max_views);
+        for (std::uint16_t k = 0; k < count; ++k) visible[k] = ranked[k].second;
       }
     }
     fields.visible_count[v] = count;

@@ -22,7 +22,14 @@ struct VisibilityOptions {
   //! The occlusion ray starts this far along N, relative to the mesh's mean edge length, so it
   //! does not hit the vertex's own faces (Embree traces in float).
   double ray_offset = 1e-3;
-  bool check() const { return max_angle_degrees > 0 && max_angle_degrees <= 90 && half_patch >= 0 && ray_offset >= 0; }
+  //! View selection (Duan et al.): of the visible views only this many are kept, those closest
+  //! to the normal (the smallest angle; the lower view index on a tie), in view order. 0 keeps
+  //! all (the thesis).
+  int max_views = 0;
+  bool check() const {
+    return max_angle_degrees > 0 && max_angle_degrees <= 90 && half_patch >= 0 && ray_offset >= 0 && max_views >= 0 &&
+           (max_views == 0 || max_views >= 2);
+  }
 };
 
 //! Fills visible_views / visible_count for the vertices of \p vertices, in view order.

@@ -6,7 +6,10 @@
 # Fold f holds out views f, f+K, f+2K, ... (spread around the rig). For each fold the hull is
 # carved WITHOUT the held-out views, refined without them, and both meshes are scored on them:
 # neither the hull, the refinement nor the colouring ever sees a held-out photograph. Prints one
-# line per fold and the mean over the folds; everything is kept under OUT/fold_F/.
+# line per fold and the mean over the folds; everything is kept under OUT/fold_F/, and
+# OUT/folds.json holds every fold's `mvflow heldout` summaries (per view and pooled) for the hull
+# and the refined mesh, and the means. The hull is `mvflow hull`'s default (no dilation) unless
+# --dilate says otherwise.
 set -euo pipefail
 mvflow=$(cd "$(dirname "$0")/.." && pwd)/build/tools/mvflow
 [ -x "$mvflow" ] || { echo "$0: $mvflow is missing: build first (bash tools/build.sh)" >&2; exit 1; }
@@ -14,7 +17,7 @@ mvflow=$(cd "$(dirname "$0")/.." && pwd)/build/tools/mvflow
 [ $# -ge 2 ] || { echo "usage: $0 SCENE OUT [--folds K] [--dilate PX] [--threshold T] [-- REFINE OPTIONS...]" >&2; exit 2; }
 scene=$1 out=$2
 shift 2
-folds=4 dilate=10 threshold=0.19
+folds=4 dilate=0 threshold=0.19
 while [ $# -gt 0 ]; do
   case $1 in
     --folds) folds=$2; shift 2 ;;
@@ -40,9 +43,11 @@ score() {
 }
 
 mkdir -p "$out"
-rm -f "$out/scores.tmp"
+rm -f "$out/scores.tmp" "$out/folds.tmp"
 step "$out/scene.log" "$mvflow" info "$scene" --json "$out/scene.json"
 views=$(grep -m1 -o '"count": *[0-9]*' "$out/scene.json" | grep -o '[0-9]*$')
+[[ $folds =~ ^[0-9]+$ ]] && [ "$folds" -ge 2 ] && [ "$folds" -le "$views" ] ||
+  { echo "$0: --folds must be a whole number from 2 to the scene's $views views (got '$folds')" >&2; exit 2; }
 
 printf '%-5s %-12s %28s %28s %s\n' fold views "hull: MAE PSNR silhouette" "refined: MAE PSNR silhouette" \
   "refined vertices, Σg/vertex before → after, seconds"
@@ -62,8 +67,32 @@ for ((f = 0; f < folds; ++f)); do
   g=$(grep '^Σg/vertex' "$dir/refine.log" | sed 's/Σg\/vertex *//')
   printf '%-5s %-12s %28s %28s %s, %s, %.1f s\n' "$f" "$held" "$hull_score" "$refined_score" "$vertices" "$g" "$seconds"
   echo "$hull_score $refined_score" >> "$out/scores.tmp"
+  {
+    [ "$f" -gt 0 ] && echo ","
+    printf '{"fold": %d, "held_out_views": [%s], "refined_vertices": %s, "refine_seconds": %s,\n"hull": ' \
+      "$f" "$held" "${vertices:-0}" "$seconds"
+    cat "$dir/hull_heldout.json"
+    printf ',\n"refined": '
+    cat "$dir/refined_heldout.json"
+    printf '}'
+  } >> "$out/folds.tmp"
 done
 mv "$out/scores.tmp" "$out/scores.txt"
-awk '{ for (i = 1; i <= 6; ++i) s[i] += $i } END {
-  printf "mean  %-12s %28s %28s\n", "", sprintf("%.4f %.2f %.4f", s[1]/NR, s[2]/NR, s[3]/NR),
-         sprintf("%.4f %.2f %.4f", s[4]/NR, s[5]/NR, s[6]/NR) }' "$out/scores.txt"
+means=$(awk '{ for (i = 1; i <= 6; ++i) s[i] += $i } END {
+  printf "%.6f %.4f %.6f %.6f %.4f %.6f %.2f", s[1]/NR, s[2]/NR, s[3]/NR, s[4]/NR, s[5]/NR, s[6]/NR,
+         100 * (s[4] - s[1]) / s[1] }' "$out/scores.txt")
+read -r hm hp hs rm rp rs change <<< "$means"
+worse=$(awk '$4 > $1 { n++ } END { print n + 0 }' "$out/scores.txt")
+{
+  printf '{"scene": "%s", "folds_count": %d, "hull_dilate": %d, "threshold": %s, "refine_options": "%s",\n' \
+    "$scene" "$folds" "$dilate" "$threshold" "${refine_options[*]}"
+  printf '"mean": {"hull": {"mae": %s, "psnr_db": %s, "silhouette_disagreement": %s},\n' "$hm" "$hp" "$hs"
+  printf '  "refined": {"mae": %s, "psnr_db": %s, "silhouette_disagreement": %s},\n' "$rm" "$rp" "$rs"
+  printf '  "mae_change_percent": %s, "folds_refined_worse": %s},\n"folds": [\n' "$change" "$worse"
+  cat "$out/folds.tmp"
+  printf ']}\n'
+} > "$out/folds.json.tmp"
+mv "$out/folds.json.tmp" "$out/folds.json"
+rm -f "$out/folds.tmp"
+printf "mean  %-12s %28s %28s\n" "" "$(printf '%.4f %.2f %.4f' "$hm" "$hp" "$hs")" "$(printf '%.4f %.2f %.4f' "$rm" "$rp" "$rs")"
+echo "refined vs hull: MAE ${change} %, worse in ${worse} of ${folds} folds (JSON: $out/folds.json)"

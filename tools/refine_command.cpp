@@ -31,6 +31,8 @@ struct RefineArguments {
   std::string step_control;       // "on" or "off"; empty: the preset's
   std::string refine_when;        // "iteration" or "converged"; empty: the preset's
   std::string convergence;        // "each-lookback" or "no-improvement"; empty: the preset's
+  std::string normalize;          // "on" or "off"; empty: the preset's
+  std::string fill_unobserved;    // "on" or "off"; empty: the preset's
   int threads = 0;
   RefineOptions options;          // values given on the command line override the preset
 };
@@ -48,9 +50,16 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"savitzky_golay_k", o.photo.savitzky_golay.k},
           {"savitzky_golay_order", o.photo.savitzky_golay.order},
           {"max_view_angle_degrees", o.visibility.max_angle_degrees},
+          {"max_views", o.visibility.max_views},
+          {"photo_normalize", o.photo.photo.normalize},
+          {"photo_noise_floor", o.photo.photo.noise_floor},
+          {"drop_views", o.photo.photo.drop_views},
+          {"drop_min_views", o.photo.photo.min_views},
+          {"fill_unobserved", o.unobserved.fill},
           {"curvature_area", o.curvature.area == CurvatureArea::Mixed ? "mixed" : "barycentric"},
           {"smoothing_lambda_dt", o.smoothing.lambda_dt},
           {"smoothing_steps", o.smoothing.steps},
+          {"smoothing_taubin_pass_band", o.smoothing.taubin_pass_band},
           {"regularization_strength", o.regularization.strength},
           {"regularization_steps", o.regularization.steps},
           {"epsilon_percent", o.stopping.epsilon_percent},
@@ -92,6 +101,7 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--max-view-angle", options.visibility.max_angle_degrees, given.visibility.max_angle_degrees);
   set("--smoothing", options.smoothing.lambda_dt, given.smoothing.lambda_dt);
   set("--smoothing-steps", options.smoothing.steps, given.smoothing.steps);
+  set("--taubin-pass-band", options.smoothing.taubin_pass_band, given.smoothing.taubin_pass_band);
   set("--regularization", options.regularization.strength, given.regularization.strength);
   set("--regularization-steps", options.regularization.steps, given.regularization.steps);
   set("--epsilon", options.stopping.epsilon_percent, given.stopping.epsilon_percent);
@@ -99,6 +109,12 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--min-iterations", options.stopping.min_iterations, given.stopping.min_iterations);
   set("--step-tolerance", options.stopping.median_move_tolerance, given.stopping.median_move_tolerance);
   set("--sg-k", options.photo.savitzky_golay.k, given.photo.savitzky_golay.k);
+  set("--max-views", options.visibility.max_views, given.visibility.max_views);
+  set("--noise-floor", options.photo.photo.noise_floor, given.photo.photo.noise_floor);
+  set("--drop-views", options.photo.photo.drop_views, given.photo.photo.drop_views);
+  set("--drop-min-views", options.photo.photo.min_views, given.photo.photo.min_views);
+  if (!args.normalize.empty()) options.photo.photo.normalize = args.normalize == "on";
+  if (!args.fill_unobserved.empty()) options.unobserved.fill = args.fill_unobserved == "on";
   set("--sg-order", options.photo.savitzky_golay.order, given.photo.savitzky_golay.order);
   if (command.count("--patch") > 0) {
     options.photo.photo.half_patch = given.photo.photo.half_patch;
@@ -193,8 +209,33 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--sg-order", o.photo.savitzky_golay.order, "Savitzky–Golay polynomial order")->capture_default_str();
   c->add_option("--max-view-angle", o.visibility.max_angle_degrees, "Views beyond this angle to the normal are not used (degrees)")
       ->capture_default_str();
+  c->add_option("--max-views", o.visibility.max_views,
+                "Keep only this many visible views per vertex, those closest to the normal (0 = all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  c->add_option("--normalize", args->normalize,
+                "Per-view gain/bias normalisation of the patches before the variance (on/off)")
+      ->check(CLI::IsMember({"on", "off"}));
+  c->add_option("--noise-floor", o.photo.photo.noise_floor,
+                "Normalisation: contrast floor σ₀ on [0,1] values (flat patches are not stretched beyond it)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  c->add_option("--drop-views", o.photo.photo.drop_views,
+                "Drop up to this many outlier views per vertex (the patches farthest from the mean)")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  c->add_option("--drop-min-views", o.photo.photo.min_views, "... while more than this many views remain")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  c->add_option("--fill-unobserved", args->fill_unobserved,
+                "Vertices without g or ∇g move with their observed neighbours (on/off)")
+      ->check(CLI::IsMember({"on", "off"}));
   c->add_option("--smoothing", o.smoothing.lambda_dt, "Curvature-normal smoothing λ·dt per step")->capture_default_str();
   c->add_option("--smoothing-steps", o.smoothing.steps, "Smoothing steps per iteration")->capture_default_str();
+  c->add_option("--taubin-pass-band", o.smoothing.taubin_pass_band,
+                "Taubin k_PB: each smoothing step is followed by one with −μ = −λ/(1 − k_PB·λ), so smoothing does "
+                "not shrink the surface (0 = off, the thesis)")
+      ->capture_default_str();
   c->add_option("--regularization", o.regularization.strength, "Tangential regularization C per step")->capture_default_str();
   c->add_option("--regularization-steps", o.regularization.steps, "Regularization steps per iteration")->capture_default_str();
   c->add_option("--epsilon", o.stopping.epsilon_percent, "Stop when Σg changes less than this (percent) over 5 iterations")
