@@ -51,6 +51,9 @@ void IterationData::reset_topology() {
   moved.assign(mesh.n_vertices(), 0.0);
   block_seconds.assign(blocks.size(), {});
   refit_needed = false;
+  iteration_start.clear();
+  last_step.clear();
+  last_time_step = 0.0;
   step_scale = 1.0;  // Σg/vertex of another mesh says nothing about the steps on this one
   previous_g_per_vertex = 0.0;
 }
@@ -66,6 +69,16 @@ void IterationData::refit() {
   StageTimer timer(serial_seconds[static_cast<int>(Stage::Refit)]);
   if (refit_needed) surface->update_positions(mesh);
   refit_needed = true;  // every later iteration moves the vertices first
+  if (options.unobserved.fill) {
+    const std::size_t n = mesh.n_vertices();
+    if (iteration_start.size() == n) {
+      last_step.resize(n);
+      for (std::size_t v = 0; v < n; ++v)
+        last_step[v] = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))) - iteration_start[v];
+    }
+    iteration_start.resize(n);
+    for (std::size_t v = 0; v < n; ++v) iteration_start[v] = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+  }
 }
 
 void IterationData::geometry(std::size_t block) {
@@ -112,6 +125,7 @@ void IterationData::cfl() {
   for (std::size_t v = 0; v < fields.size(); ++v)
     if (fields.defined[v] & kPhotoDefined) sum_g += fields.photo_consistency[v];
   total.sum_g = sum_g;
+  demote_weakly_seen(mesh, views, options.unobserved, fields);  // before the step: they only follow it
   const double reference_speed =
       options.speed_quantile < 1.0 ? speed_quantile(mesh, fields, options.speed_quantile) : total.max_speed;
   const double step_edge = options.local_step ? mean_edge : shortest_edge;
@@ -122,8 +136,20 @@ void IterationData::cfl() {
                                   : MoveLimit{.distance = cfl_fraction * shortest_edge};
   moving = 0;
   for (std::uint8_t bits : fields.defined) moving += (bits & kSpeedDefined) != 0;
-  // After Δt: the step is set by what the photographs say, the filled speeds only follow it.
-  fill_unobserved_speeds(mesh, options.unobserved, fields);
+  if (options.unobserved.fill) fill_speeds();
+}
+
+void IterationData::fill_speeds() {
+  // After Δt: the step is set by what the photographs say, the filled speeds only follow it. The
+  // observed rate is the vertex's whole last step per unit time once there is one (see
+  // stages/unobserved_speed.h), its flow speed before.
+  const bool history = last_step.size() == fields.size() && last_time_step > 0.0;
+  std::vector<double> rate(fields.size(), 0.0);
+  for (std::size_t v = 0; v < fields.size(); ++v)
+    if (fields.defined[v] & kSpeedDefined)
+      rate[v] = history ? last_step[v].dot(fields.normal[v]) / last_time_step : fields.speed[v].dot(fields.normal[v]);
+  fill_unobserved_speeds(mesh, options.unobserved, rate, fields);
+  last_time_step = time_step;
 }
 
 void IterationData::measure_moves() {

@@ -44,6 +44,10 @@ struct IterationData {
   std::vector<BlockPartial> partials;            //!< one per block
   std::vector<Eigen::Vector3d> new_positions;    //!< Jacobi buffer of smoothing / regularization
   std::vector<double> moved;                     //!< length of each vertex's move this iteration
+  //! For the unobserved-speed fill: the positions at the start of the last iteration (empty
+  //! until one ran on this topology), then each vertex's whole step in it (refit()).
+  std::vector<Eigen::Vector3d> iteration_start, last_step;
+  double last_time_step = 0.0;
   std::vector<std::array<double, kStageCount>> block_seconds;  //!< per block, per stage
 
   // Set before the iteration runs (set_edge_lengths).
@@ -77,6 +81,7 @@ struct IterationData {
   void photo_speed(std::size_t block);
   void cfl();                          //!< serial: combine partials in block order, Δt, median move
   void adapt_step_scale();             //!< part of cfl(): the step control
+  void fill_speeds();                  //!< part of cfl(): speeds of unobserved vertices
   void move(std::size_t block);        //!< P ← P + Δt·F
   void measure_moves();                //!< serial, after the iteration: median_move
   void smooth(std::size_t block);      //!< new position of curvature-normal smoothing

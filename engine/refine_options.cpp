@@ -22,6 +22,7 @@ void RefineOptions::check() const {
   require(adaptive.check(), "adaptive refinement thresholds (min growth in [0, 1))");
   require(untangling.check(), "untangling (rounds >= 0, ring >= 0, steps >= 1, fraction in (0, 1])");
   require(block_size >= 1, "block size >= 1");
+  require(image_levels >= 0 && image_levels <= 4, "image levels 0..4");
   require(silhouettes.check(), "silhouettes (threshold in [0, 1), dilation >= 0)");
   require(photo.photo.half_patch == visibility.half_patch, "the visibility patch must equal the photo patch");
   for (int view : excluded_views) require(view >= 0, "excluded views are 0-based indices");
@@ -32,6 +33,7 @@ RefineOptions default_preset() { return RefineOptions{}; }
 RefineOptions thesis_preset() {
   RefineOptions options;
   options.visibility.max_angle_degrees = 90.0;
+  options.visibility.preferred_angle_degrees = 90.0;
   options.curvature.area = CurvatureArea::Barycentric;
   options.stopping.epsilon_percent = 0.3;
   options.speed_quantile = 1.0;

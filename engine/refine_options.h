@@ -66,6 +66,11 @@ struct RefineOptions {
   bool adaptive_refinement = true;     //!< quadrisect high-curvature regions between iterations
   AdaptiveRefinementOptions adaptive;
 
+  //! Coarse-to-fine images: the flow starts on the photographs halved this many times
+  //! (stages/image_pyramid.h) and moves one level finer each time it has settled, before any
+  //! adaptive refinement; 0 = full resolution throughout (the thesis). 0..4.
+  int image_levels = 0;
+
   RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration
   //! Folds removed where the flow has settled: before each coarse-to-fine refinement (then the
   //! curvature is recomputed, so that the marks do not follow a removed fold) and at the end of

@@ -17,6 +17,7 @@
 #include "engine/mesh_stats.h"
 #include "stages/adaptive_refinement.h"
 #include "stages/curvature.h"
+#include "stages/image_pyramid.h"
 #include "stages/normals.h"
 #include "stages/photo_consistency.h"
 #include "stages/photo_robust.h"
@@ -113,10 +114,13 @@ RefineStatus status_of(StopReason reason) {
 class Refinement {
  public:
   Refinement(const Scene& scene, const Mesh& initial, const RefineOptions& options, const RefineControl& control)
-      : options_(options), control_(control), views_(usable_views(scene, options.excluded_views)),
-        mesh_(initial.topology), data_(mesh_, views_, options_, control.cancel) {
+      : options_(options), control_(control), full_views_(usable_views(scene, options.excluded_views)),
+        views_(full_views_), mesh_(initial.topology), data_(mesh_, views_, options_, control.cancel) {
+    for (int level = 0; level < options.image_levels; ++level)
+      levels_.push_back(half_resolution(level == 0 ? full_views_ : levels_.back()->views));
+    if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
     if (options.keep_inside_silhouettes) {
-      inside_.emplace(views_, threshold_silhouettes(views_, options.silhouettes));
+      inside_.emplace(full_views_, threshold_silhouettes(full_views_, options.silhouettes));
       data_.inside = &*inside_;
     }
   }
@@ -129,7 +133,7 @@ class Refinement {
     summary.initial_faces = mesh_.n_faces();
     progress(0, "preparing");
     prepare();
-    summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, views_, options_).sum_g_per_vertex;
+    summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, options_).sum_g_per_vertex;
 
     StoppingCriterion stopping(options_.stopping);
     RefineStatus status = RefineStatus::MaxIterations;
@@ -182,7 +186,7 @@ class Refinement {
     const std::optional<UntanglingResult> untangled =
         status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
     summary.untangled_pairs = untangled_pairs_;
-    const SurfaceState final_state = evaluate_surface(mesh_, views_, options_);
+    const SurfaceState final_state = evaluate_surface(mesh_, full_views_, options_);
     summary.status = status;
     summary.final_vertices = mesh_.n_vertices();
     summary.final_faces = mesh_.n_faces();
@@ -214,7 +218,7 @@ class Refinement {
   // regularization pass over the whole mesh.
   void prepare() {
     reference_edge_ = edge_lengths(mesh_).shortest;
-    pixel_size_ = finest_pixel_size(views_, bounding_box_of(mesh_).centre());
+    pixel_size_ = finest_pixel_size(full_views_, bounding_box_of(mesh_).centre());
     if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
     if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
     apply_smoothing(mesh_, options_.smoothing);
@@ -268,6 +272,13 @@ class Refinement {
   bool refine_at_convergence(StopReason reason, IterationReport& report) {
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     if (reason != StopReason::Converged && reason != StopReason::StepSmall) return false;
+    if (!levels_.empty()) {  // settled on these images: the next finer ones before any refinement
+      levels_.pop_back();
+      views_ = levels_.empty() ? full_views_ : levels_.back()->views;
+      report.stop = std::string("finer images (") + to_string(reason) + ")";
+      if (control_.logger) control_.logger->info("images at 1/{} of their resolution from here", 1 << levels_.size());
+      return true;
+    }
     const auto start = Clock::now();
     const std::optional<UntanglingResult> untangled = untangle_folds();
     if (untangled && untangled->rounds > 0) update_curvature();  // so the marks do not follow a removed fold
@@ -316,7 +327,9 @@ class Refinement {
 
   const RefineOptions& options_;
   const RefineControl& control_;
-  std::vector<PhotoView> views_;
+  std::vector<PhotoView> full_views_;  //!< the photographs the refinement may use
+  std::vector<std::unique_ptr<ImageLevel>> levels_;  //!< halved once, twice, ...; dropped as the flow gets there
+  std::vector<PhotoView> views_;       //!< the views the iterations read now (a level's or the full ones)
   TriMesh mesh_;
   IterationData data_;
   double reference_edge_ = 0.0;

@@ -8,6 +8,37 @@
 
 namespace mvflow {
 
+namespace {
+
+// View selection among the \p count visible views in \p visible (view order): those within the
+// preferred angle, topped up with the closest others to min_views, at most max_views (the closest
+// first; the lower view index on a tie). Rewrites \p visible in view order; returns the count.
+std::uint16_t select_views(const Eigen::Vector3d& P, const Eigen::Vector3d& N, const std::vector<PhotoView>& views,
+                           const VisibilityOptions& options, double cos_preferred, std::uint16_t* visible,
+                           std::uint16_t count, std::vector<std::pair<double, std::uint16_t>>& ranked) {
+  const bool preferring = options.preferred_angle_degrees < options.max_angle_degrees;
+  if (!preferring && (options.max_views == 0 || count <= options.max_views)) return count;
+  ranked.clear();  // (−cos, view): the closest to the normal first
+  for (std::uint16_t k = 0; k < count; ++k) {
+    const Eigen::Vector3d to_camera = views[visible[k]].camera->centre() - P;
+    ranked.emplace_back(-N.dot(to_camera) / to_camera.norm(), visible[k]);
+  }
+  std::sort(ranked.begin(), ranked.end());
+  std::size_t keep = ranked.size();
+  if (preferring) {
+    keep = 0;
+    while (keep < ranked.size() && -ranked[keep].first > cos_preferred) ++keep;
+    keep = std::max(keep, std::min(ranked.size(), static_cast<std::size_t>(options.min_views)));
+  }
+  if (options.max_views > 0) keep = std::min(keep, static_cast<std::size_t>(options.max_views));
+  ranked.resize(keep);
+  std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  for (std::size_t k = 0; k < keep; ++k) visible[k] = ranked[k].second;
+  return static_cast<std::uint16_t>(keep);
+}
+
+}  // namespace
+
 void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
                         const SurfaceQuery& surface, double mean_edge, const VisibilityOptions& options,
                         VertexFields& fields) {
@@ -15,7 +46,8 @@ void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vec
   MVFLOW_CHECK(fields.view_capacity >= views.size(), "vertex fields sized for fewer views");
   const double cos_max = std::cos(options.max_angle_degrees * std::numbers::pi / 180.0);
   const double offset = options.ray_offset * mean_edge;
-  std::vector<std::pair<double, std::uint16_t>> ranked;  // (−cos, view): the best first
+  const double cos_preferred = std::cos(options.preferred_angle_degrees * std::numbers::pi / 180.0);
+  std::vector<std::pair<double, std::uint16_t>> ranked;
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     std::uint16_t* visible = fields.visible_views.data() + v * fields.view_capacity;
     std::uint16_t count = 0;
@@ -35,18 +67,7 @@ void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vec
         if (surface.occluded(origin, from_origin, 0.0, 1.0)) continue;
         visible[count++] = static_cast<std::uint16_t>(i);
       }
-      if (options.max_views > 0 && count > options.max_views) {
-        ranked.clear();
-        for (std::uint16_t k = 0; k < count; ++k) {
-          const Eigen::Vector3d to_camera = views[visible[k]].camera->centre() - P;
-          ranked.emplace_back(-N.dot(to_camera) / to_camera.norm(), visible[k]);
-        }
-        std::sort(ranked.begin(), ranked.end());
-        ranked.resize(static_cast<std::size_t>(options.max_views));
-        std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-        count = static_cast<std::uint16_t>(options.max_views);
-        for (std::uint16_t k = 0; k < count; ++k) visible[k] = ranked[k].second;
-      }
+      count = select_views(P, N, views, options, cos_preferred, visible, count, ranked);
     }
     fields.visible_count[v] = count;
   }

@@ -22,12 +22,20 @@ struct VisibilityOptions {
   //! The occlusion ray starts this far along N, relative to the mesh's mean edge length, so it
   //! does not hit the vertex's own faces (Embree traces in float).
   double ray_offset = 1e-3;
-  //! View selection (Duan et al.): of the visible views only this many are kept, those closest
+  //! Views between this angle and max_angle_degrees are used only to reach min_views (the
+  //! closest to the normal first): oblique views foreshorten and mix shading, so they are a last
+  //! resort, not a peer. 45° with 3 views (README, "Defaults and differences": better on the
+  //! three synthetic scenes and on both photograph sets than 60° or none); ≥ max_angle_degrees:
+  //! every view up to max_angle_degrees counts (the thesis preset).
+  double preferred_angle_degrees = 45.0;
+  int min_views = 3;  //!< see preferred_angle_degrees; ≥ 2
+  //! View selection (Duan et al.): of the visible views at most this many are kept, those closest
   //! to the normal (the smallest angle; the lower view index on a tie), in view order. 0 keeps
   //! all (the thesis).
   int max_views = 0;
   bool check() const {
-    return max_angle_degrees > 0 && max_angle_degrees <= 90 && half_patch >= 0 && ray_offset >= 0 && max_views >= 0 &&
+    return max_angle_degrees > 0 && max_angle_degrees <= 90 && preferred_angle_degrees > 0 &&
+           preferred_angle_degrees <= 90 && min_views >= 2 && half_patch >= 0 && ray_offset >= 0 && max_views >= 0 &&
            (max_views == 0 || max_views >= 2);
   }
 };

@@ -8,10 +8,12 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <numbers>
 #include <random>
 
 #include "engine/primitives.h"
 #include "engine/surface_query.h"
+#include "stages/image_pyramid.h"
 #include "stages/normals.h"
 #include "stages/photo_robust.h"
 #include "stages/synth_cameras.h"
@@ -215,8 +217,8 @@ TEST(ViewSelection, KeepsTheViewsClosestToTheNormal) {
   compute_normals(mesh, all, every);
   compute_normals(mesh, all, best);
   const SurfaceQuery surface(mesh);
-  compute_visibility(mesh, all, views, surface, 0.1, {}, every);
-  compute_visibility(mesh, all, views, surface, 0.1, {.max_views = 2}, best);
+  compute_visibility(mesh, all, views, surface, 0.1, {.preferred_angle_degrees = 90}, every);
+  compute_visibility(mesh, all, views, surface, 0.1, {.preferred_angle_degrees = 90, .max_views = 2}, best);
   int trimmed = 0;
   for (std::uint32_t v = 0; v < mesh.n_vertices(); ++v) {
     const auto seen = every.visible(v);
@@ -233,6 +235,32 @@ TEST(ViewSelection, KeepsTheViewsClosestToTheNormal) {
     trimmed += seen.size() > 2;
   }
   EXPECT_GT(trimmed, 50);
+
+  // Preferred angle: the views within 50° of the normal, topped up to three with the closest of
+  // the others (up to the 75° limit).
+  VertexFields preferring;
+  preferring.resize(mesh.n_vertices(), views.size());
+  compute_normals(mesh, all, preferring);
+  compute_visibility(mesh, all, views, surface, 0.1, {.preferred_angle_degrees = 50, .min_views = 3}, preferring);
+  int topped_up = 0, cut = 0;
+  for (std::uint32_t v = 0; v < mesh.n_vertices(); ++v) {
+    const Eigen::Vector3d P = test::position(mesh, v);
+    std::vector<std::pair<double, std::uint16_t>> ranked;
+    for (auto id : every.visible(v)) ranked.emplace_back(-every.normal[v].dot((cameras[id].centre() - P).normalized()), id);
+    std::sort(ranked.begin(), ranked.end());
+    std::vector<std::uint16_t> expected;
+    for (std::size_t k = 0; k < ranked.size(); ++k)
+      if (-ranked[k].first > std::cos(50 * std::numbers::pi / 180) || k < 3) expected.push_back(ranked[k].second);
+    std::sort(expected.begin(), expected.end());
+    const auto kept = preferring.visible(v);
+    EXPECT_EQ(std::vector<std::uint16_t>(kept.begin(), kept.end()), expected) << "vertex " << v;
+    std::size_t within = 0;
+    for (const auto& r : ranked) within += -r.first > std::cos(50 * std::numbers::pi / 180);
+    topped_up += within < 3 && ranked.size() > within;
+    cut += expected.size() < ranked.size();
+  }
+  EXPECT_GT(topped_up, 20);
+  EXPECT_GT(cut, 20);
 }
 
 TEST(UnobservedSpeed, AVertexWithoutSpeedMovesWithItsRing) {
@@ -252,7 +280,9 @@ TEST(UnobservedSpeed, AVertexWithoutSpeedMovesWithItsRing) {
     fields.defined[v] |= kSpeedDefined;
   }
   const VertexFields before = fields;
-  const std::size_t filled = fill_unobserved_speeds(mesh, {.fill = true}, fields);
+  std::vector<double> rate(mesh.n_vertices());
+  for (std::uint32_t v = 0; v < mesh.n_vertices(); ++v) rate[v] = fields.speed[v].dot(fields.normal[v]);
+  const std::size_t filled = fill_unobserved_speeds(mesh, {.fill = true}, rate, fields);
   std::size_t unobserved = 0;
   for (std::uint32_t v = 0; v < mesh.n_vertices(); ++v) {
     if (observed[v]) {
@@ -293,11 +323,52 @@ TEST(UnobservedSpeed, OffOrWithoutAnyObservedVertexNothingMoves) {
   VertexFields fields;
   fields.resize(mesh.n_vertices(), 1);
   compute_normals(mesh, all, fields);
-  EXPECT_EQ(fill_unobserved_speeds(mesh, {.fill = true}, fields), 0u);  // nothing observed: nothing to follow
-  fields.speed[0] = -fields.normal[0];
+  const std::vector<double> rate(mesh.n_vertices(), -1.0);
+  EXPECT_EQ(fill_unobserved_speeds(mesh, {.fill = true}, rate, fields), 0u);  // nothing observed: nothing to follow
   fields.defined[0] |= kSpeedDefined;
-  EXPECT_EQ(fill_unobserved_speeds(mesh, {.fill = false}, fields), 0u);
-  EXPECT_EQ(fill_unobserved_speeds(mesh, {.fill = true, .max_rings = 1}, fields), 5u);  // vertex 0 has valence 5
+  EXPECT_EQ(fill_unobserved_speeds(mesh, {.fill = false}, rate, fields), 0u);
+  EXPECT_EQ(fill_unobserved_speeds(mesh, {.fill = true, .max_rings = 1}, rate, fields), 5u);  // vertex 0: valence 5
+}
+
+}  // namespace
+}  // namespace mvflow
+
+namespace mvflow {
+namespace {
+
+TEST(ImagePyramid, TheHalfCameraSeesTheHalfImageWhereTheFullOneSeesTheFull) {
+  // An image linear in x and y: bilinear sampling and 2×2 means reproduce it exactly, so the
+  // colour a point projects to must be the same at both levels.
+  const Camera camera = look_at({0.3, 0.5, 4}, {0, 0, 0}, {0, 1, 0}, 180, 161, 121);  // odd sizes: the last row/column drops
+  Image image(161, 121);
+  for (int y = 0; y < 121; ++y)
+    for (int x = 0; x < 161; ++x)
+      image.set_pixel(x, y, {0.002f * x + 0.001f * y, 0.5f - 0.003f * y, 0.1f + 0.001f * x});
+  const Image half = half_image(image);
+  const Camera half_cam = half_camera(camera);
+  ASSERT_EQ(half.width(), 80);
+  ASSERT_EQ(half.height(), 60);
+  EXPECT_EQ(half_cam.width(), 80);
+  EXPECT_EQ(half_cam.height(), 60);
+  std::mt19937 random(9);
+  std::uniform_real_distribution<double> coordinate(-0.6, 0.6);
+  int compared = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Vector3d X(coordinate(random), coordinate(random), coordinate(random));
+    const Projection full = camera.project(X), coarse = half_cam.project(X);
+    EXPECT_NEAR(coarse.u, (full.u - 0.5) / 2, 1e-9);
+    EXPECT_NEAR(coarse.v, (full.v - 0.5) / 2, 1e-9);
+    if (coarse.u < 0 || coarse.v < 0 || coarse.u > 79 || coarse.v > 59) continue;
+    ++compared;
+    EXPECT_LT((image.sample_bilinear(full.u, full.v) - half.sample_bilinear(coarse.u, coarse.v)).norm(), 1e-5);
+  }
+  EXPECT_GT(compared, 150);
+  std::vector<Camera> cameras{camera};
+  const auto views = make_photo_views(cameras, {&image});
+  const auto level = half_resolution(views);
+  ASSERT_EQ(level->views.size(), 1u);
+  EXPECT_EQ(level->views[0].width, 80);
+  EXPECT_EQ(level->images[0].pixel(7, 5), half.pixel(7, 5));
 }
 
 }  // namespace

@@ -276,7 +276,7 @@ TEST(Visibility, EqualsBruteForceWithAnOccluder) {
   double mean_edge = 0;
   for (auto e : mesh.topology.edges()) mean_edge += mesh.topology.calc_edge_length(e);
   mean_edge /= static_cast<double>(mesh.topology.n_edges());
-  const VisibilityOptions options;
+  const VisibilityOptions options{.preferred_angle_degrees = 90.0};  // every view up to the limit
   compute_visibility(mesh.topology, {0, static_cast<std::uint32_t>(mesh.n_vertices())}, views, surface, mean_edge,
                      options, fields);
 

@@ -11,7 +11,7 @@
 # and the refined mesh, and the means. The hull is `mvflow hull`'s default (no dilation) unless
 # --dilate says otherwise.
 set -euo pipefail
-mvflow=$(cd "$(dirname "$0")/.." && pwd)/build/tools/mvflow
+mvflow=${MVFLOW:-$(cd "$(dirname "$0")/.." && pwd)/build/tools/mvflow}  # MVFLOW: another build
 [ -x "$mvflow" ] || { echo "$0: $mvflow is missing: build first (bash tools/build.sh)" >&2; exit 1; }
 
 [ $# -ge 2 ] || { echo "usage: $0 SCENE OUT [--folds K] [--dilate PX] [--threshold T] [-- REFINE OPTIONS...]" >&2; exit 2; }

@@ -51,11 +51,15 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"savitzky_golay_order", o.photo.savitzky_golay.order},
           {"max_view_angle_degrees", o.visibility.max_angle_degrees},
           {"max_views", o.visibility.max_views},
+          {"image_levels", o.image_levels},
+          {"preferred_view_angle_degrees", o.visibility.preferred_angle_degrees},
+          {"min_views", o.visibility.min_views},
           {"photo_normalize", o.photo.photo.normalize},
           {"photo_noise_floor", o.photo.photo.noise_floor},
           {"drop_views", o.photo.photo.drop_views},
           {"drop_min_views", o.photo.photo.min_views},
           {"fill_unobserved", o.unobserved.fill},
+          {"weak_view_angle_degrees", o.unobserved.weak_angle_degrees},
           {"curvature_area", o.curvature.area == CurvatureArea::Mixed ? "mixed" : "barycentric"},
           {"smoothing_lambda_dt", o.smoothing.lambda_dt},
           {"smoothing_steps", o.smoothing.steps},
@@ -94,6 +98,7 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--silhouette-threshold", options.silhouettes.threshold, given.silhouettes.threshold);
   set("--silhouette-dilate", options.silhouettes.dilate, given.silhouettes.dilate);
   if (command.count("--keep-inside-silhouettes") > 0) options.keep_inside_silhouettes = true;
+
   set("--refine-min-pixels", options.adaptive.min_edge_pixels, given.adaptive.min_edge_pixels);
   set("--refine-curvature", options.adaptive.curvature_factor, given.adaptive.curvature_factor);
   set("--refine-min-growth", options.adaptive.min_growth, given.adaptive.min_growth);
@@ -110,11 +115,15 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--step-tolerance", options.stopping.median_move_tolerance, given.stopping.median_move_tolerance);
   set("--sg-k", options.photo.savitzky_golay.k, given.photo.savitzky_golay.k);
   set("--max-views", options.visibility.max_views, given.visibility.max_views);
+  set("--image-levels", options.image_levels, given.image_levels);
+  set("--preferred-view-angle", options.visibility.preferred_angle_degrees, given.visibility.preferred_angle_degrees);
+  set("--min-views", options.visibility.min_views, given.visibility.min_views);
   set("--noise-floor", options.photo.photo.noise_floor, given.photo.photo.noise_floor);
   set("--drop-views", options.photo.photo.drop_views, given.photo.photo.drop_views);
   set("--drop-min-views", options.photo.photo.min_views, given.photo.photo.min_views);
   if (!args.normalize.empty()) options.photo.photo.normalize = args.normalize == "on";
   if (!args.fill_unobserved.empty()) options.unobserved.fill = args.fill_unobserved == "on";
+  set("--weak-view-angle", options.unobserved.weak_angle_degrees, given.unobserved.weak_angle_degrees);
   set("--sg-order", options.photo.savitzky_golay.order, given.photo.savitzky_golay.order);
   if (command.count("--patch") > 0) {
     options.photo.photo.half_patch = given.photo.photo.half_patch;
@@ -213,6 +222,18 @@ void add_refine_command(CLI::App& app, Runner& runner) {
                 "Keep only this many visible views per vertex, those closest to the normal (0 = all)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  c->add_option("--preferred-view-angle", o.visibility.preferred_angle_degrees,
+                "Views beyond this angle to the normal (up to --max-view-angle) only top a vertex's views up to "
+                "--min-views, the closest first (degrees)")
+      ->check(CLI::Range(1.0, 90.0))
+      ->capture_default_str();
+  c->add_option("--min-views", o.visibility.min_views, "See --preferred-view-angle")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  c->add_option("--image-levels", o.image_levels,
+                "Start on the photographs halved this many times, one level finer each time the flow settles")
+      ->check(CLI::Range(0, 4))
+      ->capture_default_str();
   c->add_option("--normalize", args->normalize,
                 "Per-view gain/bias normalisation of the patches before the variance (on/off)")
       ->check(CLI::IsMember({"on", "off"}));
@@ -230,6 +251,11 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--fill-unobserved", args->fill_unobserved,
                 "Vertices without g or ∇g move with their observed neighbours (on/off)")
       ->check(CLI::IsMember({"on", "off"}));
+  c->add_option("--weak-view-angle", o.unobserved.weak_angle_degrees,
+                "--fill-unobserved on: a vertex whose views all lie beyond this angle to its normal follows its "
+                "neighbours too (degrees; 90 = only vertices without g or ∇g)")
+      ->check(CLI::Range(1.0, 90.0))
+      ->capture_default_str();
   c->add_option("--smoothing", o.smoothing.lambda_dt, "Curvature-normal smoothing λ·dt per step")->capture_default_str();
   c->add_option("--smoothing-steps", o.smoothing.steps, "Smoothing steps per iteration")->capture_default_str();
   c->add_option("--taubin-pass-band", o.smoothing.taubin_pass_band,
@@ -281,6 +307,7 @@ void add_refine_command(CLI::App& app, Runner& runner) {
                 "Silhouettes for --keep-inside-silhouettes: largest channel above this (on [0,1])")
       ->capture_default_str();
   c->add_option("--silhouette-dilate", o.silhouettes.dilate, "... dilated by this many pixels")->capture_default_str();
+
   c->add_flag("--no-adaptive", args->no_adaptive, "Skip adaptive refinement between iterations");
   c->add_option("--exclude-views", o.excluded_views, "0-based views not to use (held out)")->delimiter(',');
   c->add_flag("--ascii", args->ascii, "Write PLY as ASCII");
