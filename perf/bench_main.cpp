@@ -21,6 +21,7 @@
 #include "perf/openmvs_case.h"
 #include "perf/peak_memory.h"
 #include "perf/thesis_suite.h"
+#include "stages/photo_kernel.h"
 
 namespace mvflow::perf {
 namespace {
@@ -149,6 +150,7 @@ int run(int argc, char** argv) {
     return line;
   }();
   document["machine"] = machine_description();
+  document["photo_kernel"] = photo_kernel_summary();  // MVFLOW_KERNEL=baseline|avx2|avx512 forces one
   document["peak_memory_reset"] = reset_peak_memory();
   std::map<std::string, std::vector<Row>> tables;
   for (const std::string& suite : suites) {

@@ -20,7 +20,9 @@ constexpr int kMaxValues = 3 * kMaxSide * kMaxSide;
 // C = h + fy·(h' − h) down, and g = (Σ C² − Σ_values (Σ_i C)²/m) / ((m − 1)·side²) from sums in
 // double. A patch row is 3·side contiguous floats, read at two horizontal offsets (0 and 3 = the
 // next pixel): loops the compiler vectorizes.
+#if defined(__x86_64__)
 __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
+#endif
 PhotoValue photo_consistency_any(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                                  const std::vector<PhotoView>& views, int h) {
   const int side = 2 * h + 1;

@@ -1,10 +1,15 @@
 #include "stages/photo_kernel.h"
 
+#if defined(__x86_64__) || defined(__i386__)
+#define MVFLOW_KERNEL_X86 1
 #include <immintrin.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 
 #include "engine/error.h"
 
@@ -17,8 +22,9 @@ namespace baseline {
 #include "stages/photo_kernel_body.inc"
 }  // namespace baseline
 
+#ifdef MVFLOW_KERNEL_X86
 #pragma GCC push_options
-#pragma GCC target("avx2")
+#pragma GCC target("arch=x86-64-v3")  // AVX2 with FMA, BMI2, F16C (no contraction: -ffp-contract=off keeps the bits)
 namespace avx2 {
 #include "stages/photo_kernel_body.inc"
 }  // namespace avx2
@@ -36,35 +42,46 @@ namespace avx512 {
 #undef MVFLOW_KERNEL_AVX512
 #pragma GCC diagnostic pop
 #pragma GCC pop_options
+#endif
 
-// GCC function multiversioning: a resolver picks one build at load time. Callers in other
-// files see only the unversioned functions below (GCC dispatches only where every version is
-// visible).
-#define MVFLOW_VERSIONED(target_name, build)                                                             \
-  __attribute__((target(target_name))) PhotoValue evaluate_5x5(                                          \
-      const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views) { \
-    return build::photo_consistency_5x5(X, view_ids, views);                                             \
-  }                                                                                                      \
-  __attribute__((target(target_name))) void evaluate_5x5_samples(                                        \
-      const Eigen::Vector3d& X, double spacing, int half, std::span<const std::uint16_t> view_ids,       \
-      const std::vector<PhotoView>& views, std::span<PhotoValue> samples) {                              \
-    build::photo_consistency_5x5_samples(X, spacing, half, view_ids, views, samples);                    \
+namespace {
+
+// The one dispatcher (production and tests alike): MVFLOW_KERNEL when set, else the widest
+// build this CPU runs. Chosen once, on first use.
+const PhotoKernelBuild& choose_build() {
+  const std::vector<PhotoKernelBuild> builds = photo_kernel_builds();
+  const char* forced = std::getenv("MVFLOW_KERNEL");
+  if (forced == nullptr || *forced == '\0') return *new PhotoKernelBuild(builds.back());  // lives for the program
+  std::string runnable;
+  for (const PhotoKernelBuild& build : builds) {
+    if (std::strcmp(build.name, forced) == 0) return *new PhotoKernelBuild(build);
+    runnable += (runnable.empty() ? "" : ", ") + std::string(build.name);
   }
-MVFLOW_VERSIONED("default", baseline)
-MVFLOW_VERSIONED("avx2", avx2)
-MVFLOW_VERSIONED("arch=x86-64-v4", avx512)
-#undef MVFLOW_VERSIONED
+  const bool known = std::strcmp(forced, "baseline") == 0 || std::strcmp(forced, "avx2") == 0 ||
+                     std::strcmp(forced, "avx512") == 0;
+  throw Error(std::string("MVFLOW_KERNEL=") + forced +
+              (known ? ": this CPU cannot run that build of the photo kernel (it runs: "
+                     : ": unknown build of the photo kernel (expected baseline, avx2 or avx512; this CPU runs: ") +
+              runnable + ")");
+}
+
+}  // namespace
+
+const PhotoKernelBuild& active_photo_kernel() {
+  static const PhotoKernelBuild& build = choose_build();
+  return build;
+}
 
 PhotoValue photo_consistency_5x5(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                                  const std::vector<PhotoView>& views) {
-  return evaluate_5x5(X, view_ids, views);
+  return active_photo_kernel().consistency(X, view_ids, views);
 }
 
 void photo_consistency_5x5_samples(const Eigen::Vector3d& X, double spacing, int half,
                                 std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
                                 std::span<PhotoValue> samples) {
   MVFLOW_CHECK(samples.size() >= static_cast<std::size_t>(6 * half + 1), "photo_consistency_5x5_samples: too few samples");
-  evaluate_5x5_samples(X, spacing, half, view_ids, views, samples);
+  active_photo_kernel().samples(X, spacing, half, view_ids, views, samples);
 }
 
 void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
@@ -89,12 +106,28 @@ void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> v
 std::vector<PhotoKernelBuild> photo_kernel_builds() {
   std::vector<PhotoKernelBuild> builds{
       {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_samples}};
-  if (__builtin_cpu_supports("avx2"))
+#ifdef MVFLOW_KERNEL_X86
+  if (__builtin_cpu_supports("x86-64-v3"))
     builds.push_back({"avx2", &avx2::photo_consistency_5x5, &avx2::photo_consistency_5x5_samples});
-  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
-      __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512cd"))
+  if (__builtin_cpu_supports("x86-64-v4"))
     builds.push_back({"avx512", &avx512::photo_consistency_5x5, &avx512::photo_consistency_5x5_samples});
+#endif
   return builds;
 }
 
 }  // namespace mvflow::detail
+
+namespace mvflow {
+
+std::string photo_kernel_summary() {
+  const detail::PhotoKernelBuild& active = detail::active_photo_kernel();
+  std::string runnable;
+  for (const detail::PhotoKernelBuild& build : detail::photo_kernel_builds())
+    runnable += (runnable.empty() ? "" : ", ") + std::string(build.name);
+  const char* forced = std::getenv("MVFLOW_KERNEL");
+  const bool by_variable = forced != nullptr && *forced != '\0';
+  return std::string(active.name) + (by_variable ? " (forced by MVFLOW_KERNEL; this CPU runs: " : " (the widest this CPU runs: ") +
+         runnable + ")";
+}
+
+}  // namespace mvflow

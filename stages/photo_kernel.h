@@ -1,7 +1,8 @@
 #pragma once
 // The hot loops of the photo stages for the default 5×5 patch (SPEC §3), in three builds of the
-// same source (x86-64 baseline, AVX2, AVX-512), the fastest one the CPU runs chosen once at load
-// time (GCC function multiversioning). Every build gives the same bits: each patch value is
+// same source (x86-64 baseline, AVX2, AVX-512; the baseline alone on other processors), one of
+// them chosen once, on first use, by active_photo_kernel(): the one named by the environment
+// variable MVFLOW_KERNEL (baseline, avx2 or avx512), else the widest one the CPU runs. Every build gives the same bits: each patch value is
 // interpolated by the same float operations and summed by the same double operations in the
 // same order (no FMA contraction); only the lane width differs. Callers use photo_consistency()
 // and PhotoGradientStage.
@@ -9,6 +10,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "stages/photo_consistency.h"
@@ -45,4 +47,19 @@ struct PhotoKernelBuild {
 //! The builds this CPU can run, baseline first.
 std::vector<PhotoKernelBuild> photo_kernel_builds();
 
+//! The build photo_consistency_5x5 and photo_consistency_5x5_samples run: MVFLOW_KERNEL's when
+//! set, else the last (widest) of photo_kernel_builds(). Chosen on the first call.
+//! \throw Error when MVFLOW_KERNEL names an unknown build or one this CPU cannot run (every later
+//!        call throws again).
+const PhotoKernelBuild& active_photo_kernel();
+
 }  // namespace mvflow::detail
+
+namespace mvflow {
+
+//! Which build of the photo kernel runs and why, e.g. "avx512 (the widest this CPU runs: baseline,
+//! avx2, avx512)" or "baseline (forced by MVFLOW_KERNEL; this CPU runs: baseline, avx2)".
+//! \throw Error as detail::active_photo_kernel().
+std::string photo_kernel_summary();
+
+}  // namespace mvflow

@@ -57,9 +57,10 @@ struct CommandResult {
   std::string output;
 };
 
-//! Runs `mvflow ARGUMENTS` (the binary this build made) and waits for it.
-inline CommandResult run_mvflow(const std::string& arguments) {
-  const std::string command = std::string(MVFLOW_BINARY) + " " + arguments + " 2>&1";
+//! Runs `ENVIRONMENT mvflow ARGUMENTS` (the binary this build made; ENVIRONMENT as NAME=VALUE
+//! words for the shell) and waits for it.
+inline CommandResult run_mvflow_with_environment(const std::string& environment, const std::string& arguments) {
+  const std::string command = environment + " " + std::string(MVFLOW_BINARY) + " " + arguments + " 2>&1";
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;
@@ -69,6 +70,9 @@ inline CommandResult run_mvflow(const std::string& arguments) {
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
 }
+
+//! Runs `mvflow ARGUMENTS` (the binary this build made) and waits for it.
+inline CommandResult run_mvflow(const std::string& arguments) { return run_mvflow_with_environment("", arguments); }
 
 //! Möller–Trumbore in double: where the ray origin + t·direction (t > 0) meets triangle (a, b, c),
 //! in units of |direction|; the independent reference for Embree's answers.

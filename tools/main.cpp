@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "engine/error.h"
+#include "stages/photo_kernel.h"
 #include "tools/commands.h"
 
 #ifndef MVFLOW_VERSION
@@ -16,7 +17,13 @@
 int main(int argc, char** argv) {
   using namespace mvflow::cli;
   CLI::App app{"mvflow: refines a coarse mesh of an object into a photo-consistent surface, from calibrated photographs"};
-  app.set_version_flag("--version", std::string("mvflow ") + MVFLOW_VERSION);
+  std::string kernel;
+  try {
+    kernel = mvflow::photo_kernel_summary();
+  } catch (const mvflow::Error& e) {
+    kernel = e.what();
+  }
+  app.set_version_flag("--version", std::string("mvflow ") + MVFLOW_VERSION + "\nphoto kernel: " + kernel);
   app.require_subcommand(1);
   app.fallthrough();
   bool verbose = false;
@@ -51,6 +58,7 @@ int main(int argc, char** argv) {
   log->set_pattern("[%l] %v");
   log->set_level(verbose ? spdlog::level::debug : spdlog::level::from_str(log_level));
   try {
+    log->debug("photo kernel: {}", mvflow::photo_kernel_summary());  // a bad MVFLOW_KERNEL fails here, before any work
     return runner(*log);
   } catch (const mvflow::Error& e) {
     log->error("{}", e.what());

@@ -11,6 +11,7 @@
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
+#include "stages/photo_kernel.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {
@@ -173,6 +174,7 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   const RefineSummary& s = result.summary;
   if (!args.report.empty()) {
     const nlohmann::json inputs = {{"scene", scene.folder.string()}, {"mesh", mesh_file}, {"views", scene.size()},
+                                   {"photo_kernel", detail::active_photo_kernel().name},
                                    {"threads", args.threads}};
     io::write_report(args.report, s, inputs, options_json(options, args.preset));
   }
