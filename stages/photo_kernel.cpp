@@ -19,15 +19,19 @@
 namespace mvflow::detail {
 
 namespace baseline {
+constexpr int kLanes = 2;  // SSE2: two doubles per xmm register
 #include "stages/photo_kernel_body.inc"
 }  // namespace baseline
 
 #ifdef MVFLOW_KERNEL_X86
 #pragma GCC push_options
 #pragma GCC target("arch=x86-64-v3")  // AVX2 with FMA, BMI2, F16C (no contraction: -ffp-contract=off keeps the bits)
+#define MVFLOW_KERNEL_AVX2
 namespace avx2 {
+constexpr int kLanes = 4;  // four doubles per ymm register
 #include "stages/photo_kernel_body.inc"
 }  // namespace avx2
+#undef MVFLOW_KERNEL_AVX2
 #pragma GCC pop_options
 
 #pragma GCC push_options
@@ -37,6 +41,7 @@ namespace avx2 {
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #define MVFLOW_KERNEL_AVX512
 namespace avx512 {
+constexpr int kLanes = 8;  // eight doubles per zmm register
 #include "stages/photo_kernel_body.inc"
 }  // namespace avx512
 #undef MVFLOW_KERNEL_AVX512
