@@ -267,10 +267,10 @@ class Refinement {
     return mesh_.n_faces() != faces;
   }
 
-  // The coarse-to-fine schedule: when the flow has settled at this resolution, refine; true when
-  // that changed the mesh (the run goes on at the finer resolution), recorded in \p report.
+  // The coarse-to-fine schedule: when the flow has settled on coarser images, the next finer ones
+  // (with either refinement schedule); at full resolution, refine; true when that changed the
+  // images or the mesh (the run goes on), recorded in \p report.
   bool refine_at_convergence(StopReason reason, IterationReport& report) {
-    if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     if (reason != StopReason::Converged && reason != StopReason::StepSmall) return false;
     if (!levels_.empty()) {  // settled on these images: the next finer ones before any refinement
       levels_.pop_back();
@@ -279,6 +279,7 @@ class Refinement {
       if (control_.logger) control_.logger->info("images at 1/{} of their resolution from here", 1 << levels_.size());
       return true;
     }
+    if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     const auto start = Clock::now();
     const std::optional<UntanglingResult> untangled = untangle_folds();
     if (untangled && untangled->rounds > 0) update_curvature();  // so the marks do not follow a removed fold

@@ -67,7 +67,17 @@ std::vector<RefineOptions> determinism_cases() {
   optional_rules.step_control = true;
   optional_rules.keep_inside_silhouettes = true;
   optional_rules.silhouettes.threshold = 0.6;
-  return {by_default, thesis_rules, optional_rules};
+  // The options for real photographs: coarser images first, speeds filled for unobserved and
+  // obliquely seen vertices, outlier views dropped, at most 5 views.
+  RefineOptions photograph_rules = by_default;
+  photograph_rules.stopping.max_iterations = 18;
+  photograph_rules.image_levels = 1;
+  photograph_rules.unobserved.fill = true;
+  photograph_rules.unobserved.weak_angle_degrees = 60.0;
+  photograph_rules.photo.photo.drop_views = 1;
+  photograph_rules.photo.photo.min_views = 3;
+  photograph_rules.visibility.max_views = 5;
+  return {by_default, thesis_rules, optional_rules, photograph_rules};
 }
 
 void expect_same_bits(const RefineOptions& options) {
@@ -153,6 +163,34 @@ TEST(Refiner, RefinesCoarseToFineWhenTheFlowHasConverged) {
   }
   EXPECT_GE(refinements, 1u);
   EXPECT_EQ(result.mesh.n_vertices(), iterations.back().vertices);
+}
+
+TEST(Refiner, CoarserImagesFirstThenTheFullOnesThenRefinement) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = few_iterations(20);
+  options.stopping.min_iterations = 6;
+  options.stopping.epsilon_percent = 50.0;  // "converged" as soon as the rules may fire
+  options.image_levels = 2;
+  const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+  const auto& iterations = result.summary.iterations;
+  std::vector<std::size_t> finer, refined;
+  for (std::size_t i = 0; i < iterations.size(); ++i) {
+    if (iterations[i].stop.starts_with("finer images (")) finer.push_back(i);
+    if (iterations[i].stop.starts_with("refined (")) refined.push_back(i);
+  }
+  // Quarter, then half, then full resolution, each after the flow settled; the mesh is refined
+  // only after that, and switching images does not change it.
+  ASSERT_EQ(finer.size(), 2u);
+  EXPECT_GE(finer[0], 5u);
+  EXPECT_GE(finer[1], finer[0] + 6);
+  for (const std::size_t i : finer) {
+    EXPECT_EQ(iterations[i].refined_faces, 0u);
+    if (i + 1 < iterations.size()) {
+      EXPECT_EQ(iterations[i + 1].vertices, iterations[i].vertices);
+    }
+  }
+  for (const std::size_t i : refined) EXPECT_GT(i, finer[1]);
 }
 
 TEST(Refiner, ARefinementBelowTheMinimumGrowthEndsTheRun) {
