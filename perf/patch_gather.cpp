@@ -3,7 +3,10 @@
 #include <cmath>
 #include <cstring>
 
+#include <string>
+
 #include "stages/photo_consistency.h"
+#include "stages/photo_kernel.h"
 
 namespace mvflow::perf {
 
@@ -33,32 +36,58 @@ std::vector<PatchBlock> gradient_patch_blocks(const std::vector<Eigen::Vector3d>
 // The 8-lane vector type is passed only to an always-inlined function of the same build.
 #pragma GCC diagnostic ignored "-Wpsabi"
 
-namespace {
-using Floats = float __attribute__((vector_size(32)));
-
-[[gnu::always_inline]] inline Floats load(const float* p) {
-  Floats f;
-  std::memcpy(&f, p, sizeof f);
-  return f;
-}
-}  // namespace
-
-// The widest loads this CPU has, as the photo kernel (stages/photo_kernel.cpp).
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
-float gather_patch_blocks(std::span<const PatchBlock> blocks) {
-  Floats a = {}, b = {}, c = {};
-  for (const PatchBlock& block : blocks) {
-    const float* row = block.top_left;
-    for (int r = 0; r < 6; ++r, row += block.stride) {  // 18 floats: [0, 8) [8, 16) [10, 18)
-      a += load(row);
-      b += load(row + 8);
-      c += load(row + 10);
-    }
+// The same loop compiled for each build of the photo kernel (stages/photo_kernel.cpp), so that
+// each build's reads are measured with that build's loads.
+#define MVFLOW_GATHER_BODY                                                                          \
+  using Floats = float __attribute__((vector_size(32)));                                            \
+  [[gnu::always_inline]] inline Floats load(const float* p) {                                       \
+    Floats f;                                                                                       \
+    std::memcpy(&f, p, sizeof f);                                                                   \
+    return f;                                                                                       \
+  }                                                                                                 \
+  float gather(std::span<const PatchBlock> blocks) {                                                \
+    Floats a = {}, b = {}, c = {};                                                                  \
+    for (const PatchBlock& block : blocks) {                                                        \
+      const float* row = block.top_left;                                                            \
+      for (int r = 0; r < 6; ++r, row += block.stride) { /* 18 floats: [0, 8) [8, 16) [10, 18) */   \
+        a += load(row);                                                                             \
+        b += load(row + 8);                                                                         \
+        c += load(row + 10);                                                                        \
+      }                                                                                             \
+    }                                                                                               \
+    const Floats total = a + b + c;                                                                 \
+    float sum = 0;                                                                                  \
+    for (int j = 0; j < 8; ++j) sum += total[j];                                                    \
+    return sum;                                                                                     \
   }
-  const Floats total = a + b + c;
-  float sum = 0;
-  for (int j = 0; j < 8; ++j) sum += total[j];
-  return sum;
+
+namespace baseline {
+MVFLOW_GATHER_BODY
+}  // namespace baseline
+
+#if defined(__x86_64__) || defined(__i386__)
+#pragma GCC push_options
+#pragma GCC target("arch=x86-64-v3")
+namespace avx2 {
+MVFLOW_GATHER_BODY
+}  // namespace avx2
+#pragma GCC pop_options
+#pragma GCC push_options
+#pragma GCC target("arch=x86-64-v4")
+namespace avx512 {
+MVFLOW_GATHER_BODY
+}  // namespace avx512
+#pragma GCC pop_options
+#endif
+#undef MVFLOW_GATHER_BODY
+
+float gather_patch_blocks(std::span<const PatchBlock> blocks) {
+#if defined(__x86_64__) || defined(__i386__)
+  const std::string build = detail::active_photo_kernel().name;
+  if (build == "avx512") return avx512::gather(blocks);
+  if (build == "avx2") return avx2::gather(blocks);
+#endif
+  return baseline::gather(blocks);
 }
 
 }  // namespace mvflow::perf

@@ -26,7 +26,8 @@ std::vector<PatchBlock> gradient_patch_blocks(const std::vector<Eigen::Vector3d>
                                               const std::vector<std::vector<std::uint16_t>>& visible,
                                               const std::vector<PhotoView>& views, double spacing, int half);
 
-//! Loads every float of every block (6 rows × 18 floats) and returns their sum.
+//! Loads every float of every block (6 rows × 18 floats) and returns their sum, compiled for the
+//! build of the photo kernel that runs (detail::active_photo_kernel(), MVFLOW_KERNEL).
 float gather_patch_blocks(std::span<const PatchBlock> blocks);
 
 }  // namespace mvflow::perf

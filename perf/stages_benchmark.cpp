@@ -24,6 +24,7 @@
 #include "stages/normals.h"
 #include "stages/photo_consistency.h"
 #include "stages/photo_gradient.h"
+#include "stages/photo_kernel.h"
 #include "stages/regularization.h"
 #include "stages/smoothing.h"
 #include "stages/speed.h"
@@ -171,7 +172,8 @@ void BM_PatchGatherBound(benchmark::State& state) {
       static_cast<double>(blocks.size()) * kPixelsPerPatch * static_cast<double>(state.iterations()),
       benchmark::Counter::kIsRate);
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(blocks.size()));
-  state.SetLabel("items = 6x6-pixel blocks of the gradient's samples");
+  state.SetLabel(std::string("items = 6x6-pixel blocks of the gradient's samples; loads of the ") +
+                 detail::active_photo_kernel().name + " build");
 }
 BENCHMARK(BM_PatchGatherBound)->Unit(benchmark::kMillisecond);
 
