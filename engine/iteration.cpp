@@ -125,7 +125,12 @@ void IterationData::cfl() {
   for (std::size_t v = 0; v < fields.size(); ++v)
     if (fields.defined[v] & kPhotoDefined) sum_g += fields.photo_consistency[v];
   total.sum_g = sum_g;
-  demote_weakly_seen(mesh, views, options.unobserved, fields);  // before the step: they only follow it
+  // Before the step: weakly seen vertices only follow it, so they leave the maximum too.
+  if (demote_weakly_seen(mesh, views, options.unobserved, fields) > 0) {
+    total.max_speed = 0.0;
+    for (std::size_t v = 0; v < fields.size(); ++v)
+      if (fields.defined[v] & kSpeedDefined) total.max_speed = std::max(total.max_speed, fields.speed[v].norm());
+  }
   const double reference_speed =
       options.speed_quantile < 1.0 ? speed_quantile(mesh, fields, options.speed_quantile) : total.max_speed;
   const double step_edge = options.local_step ? mean_edge : shortest_edge;

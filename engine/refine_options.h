@@ -67,8 +67,9 @@ struct RefineOptions {
   AdaptiveRefinementOptions adaptive;
 
   //! Coarse-to-fine images: the flow starts on the photographs halved this many times
-  //! (stages/image_pyramid.h) and moves one level finer each time it has settled, before any
-  //! adaptive refinement; 0 = full resolution throughout (the thesis). 0..4.
+  //! (stages/image_pyramid.h) and moves one level finer each time it has settled; adaptive
+  //! refinement (with either schedule) waits for the full resolution; 0 = full resolution
+  //! throughout (the thesis). 0..4.
   int image_levels = 0;
 
   RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration

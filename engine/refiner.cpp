@@ -146,7 +146,9 @@ class Refinement {
       IterationReport report;
       report.iteration = iteration;
       double refinement_seconds = 0.0;
-      const bool refine_now = options_.refinement_schedule == RefinementSchedule::EveryIteration && iteration > 1;
+      // Refinement waits for the full-resolution images with either schedule.
+      const bool refine_now =
+          options_.refinement_schedule == RefinementSchedule::EveryIteration && iteration > 1 && levels_.empty();
       if ((refine_now && adapt(report, refinement_seconds)) || !data_.surface) {
         data_.reset_topology();
         graph_.reset();
@@ -275,6 +277,8 @@ class Refinement {
     if (!levels_.empty()) {  // settled on these images: the next finer ones before any refinement
       levels_.pop_back();
       views_ = levels_.empty() ? full_views_ : levels_.back()->views;
+      data_.step_scale = 1.0;  // Σg/vertex on other images says nothing about the steps on these
+      data_.previous_g_per_vertex = 0.0;
       report.stop = std::string("finer images (") + to_string(reason) + ")";
       if (control_.logger) control_.logger->info("images at 1/{} of their resolution from here", 1 << levels_.size());
       return true;

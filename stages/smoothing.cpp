@@ -8,7 +8,8 @@
 namespace mvflow {
 
 bool SmoothingOptions::check() const {
-  return lambda_dt > 0.0 && lambda_dt < 1.0 && steps >= 0 && taubin_pass_band >= 0.0 && taubin_mu() < 1.0;
+  return lambda_dt > 0.0 && lambda_dt < 1.0 && steps >= 0 && taubin_pass_band >= 0.0 &&
+         taubin_pass_band * lambda_dt < 1.0 && taubin_mu() < 1.0;
 }
 
 namespace {

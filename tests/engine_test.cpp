@@ -190,6 +190,7 @@ TEST(Refiner, CoarserImagesFirstThenTheFullOnesThenRefinement) {
       EXPECT_EQ(iterations[i + 1].vertices, iterations[i].vertices);
     }
   }
+  ASSERT_FALSE(refined.empty());
   for (const std::size_t i : refined) EXPECT_GT(i, finer[1]);
 }
 

@@ -184,7 +184,7 @@ TEST(OutlierViews, DropsTheViewWhoseRemovalLowersTheVarianceMost) {
   ASSERT_EQ(kept.size(), ids.size() - 1);
   EXPECT_EQ(std::find(kept.begin(), kept.end(), std::uint16_t{4}), kept.end());
   EXPECT_NEAR(photo_consistency(Eigen::Vector3d::Zero(), kept, views).g, best_g, 1e-12 * best_g);
-  // Never below min_views: with 7 views and min 6 at most one goes, with min 7 none.
+  // Never below min_views: with 7 views and min 7 none goes.
   fields.visible_count[0] = static_cast<std::uint16_t>(ids.size());
   std::copy(ids.begin(), ids.end(), fields.visible_views.begin());
   drop_outlier_views(mesh, {0, 1}, views, {.drop_views = 3, .min_views = 7}, fields);

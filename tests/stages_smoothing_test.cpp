@@ -119,6 +119,7 @@ TEST(Smoothing, TaubinPairsRemoveNoiseWithoutShrinking) {
   EXPECT_LT(noise_after, 0.95 * noise_before);  // measured 0.90: weaker than plain steps, but no shrink
   EXPECT_FALSE((SmoothingOptions{.lambda_dt = 0.1, .taubin_pass_band = -0.1}.check()));
   EXPECT_FALSE((SmoothingOptions{.lambda_dt = 0.9, .taubin_pass_band = 0.5}.check()));  // μ ≥ 1
+  EXPECT_FALSE((SmoothingOptions{.lambda_dt = 0.1, .taubin_pass_band = 20}.check()));  // μ < 0: a second shrink
 }
 
 TEST(Smoothing, KeepsBoundaryVerticesAndFlatInteriorsInTheirPlane) {

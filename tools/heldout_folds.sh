@@ -46,7 +46,7 @@ mkdir -p "$out"
 rm -f "$out/scores.tmp" "$out/folds.tmp"
 step "$out/scene.log" "$mvflow" info "$scene" --json "$out/scene.json"
 views=$(grep -m1 -o '"count": *[0-9]*' "$out/scene.json" | grep -o '[0-9]*$')
-[[ $folds =~ ^[0-9]+$ ]] && [ "$folds" -ge 2 ] && [ "$folds" -le "$views" ] ||
+[[ $folds =~ ^[0-9]+$ ]] && folds=$((10#$folds)) && [ "$folds" -ge 2 ] && [ "$folds" -le "$views" ] ||
   { echo "$0: --folds must be a whole number from 2 to the scene's $views views (got '$folds')" >&2; exit 2; }
 
 printf '%-5s %-12s %28s %28s %s\n' fold views "hull: MAE PSNR silhouette" "refined: MAE PSNR silhouette" \
@@ -63,8 +63,8 @@ for ((f = 0; f < folds; ++f)); do
   seconds=$(awk -v a="$start" -v b="$(date +%s%N)" 'BEGIN { print (b - a) / 1e9 }')
   hull_score=$(score "$dir/hull.ply" "$held" "$dir/hull_heldout.json")
   refined_score=$(score "$dir/refined.ply" "$held" "$dir/refined_heldout.json")
-  vertices=$(grep -o '→ [0-9]* vertices' "$dir/refine.log" | grep -o '[0-9]*')
-  g=$(grep '^Σg/vertex' "$dir/refine.log" | sed 's/Σg\/vertex *//')
+  vertices=$(grep -o '→ [0-9]* vertices' "$dir/refine.log" | grep -o '[0-9]*' || true)
+  g=$(grep '^Σg/vertex' "$dir/refine.log" | sed 's/Σg\/vertex *//' || true)
   printf '%-5s %-12s %28s %28s %s, %s, %.1f s\n' "$f" "$held" "$hull_score" "$refined_score" "$vertices" "$g" "$seconds"
   echo "$hull_score $refined_score" >> "$out/scores.tmp"
   {
@@ -83,9 +83,11 @@ means=$(awk '{ for (i = 1; i <= 6; ++i) s[i] += $i } END {
          100 * (s[4] - s[1]) / s[1] }' "$out/scores.txt")
 read -r hm hp hs rm rp rs change <<< "$means"
 worse=$(awk '$4 > $1 { n++ } END { print n + 0 }' "$out/scores.txt")
+# A JSON string: backslashes and quotes escaped.
+json_string() { local text=${1//\\/\\\\}; printf '"%s"' "${text//\"/\\\"}"; }
 {
-  printf '{"scene": "%s", "folds_count": %d, "hull_dilate": %d, "threshold": %s, "refine_options": "%s",\n' \
-    "$scene" "$folds" "$dilate" "$threshold" "${refine_options[*]}"
+  printf '{"scene": %s, "folds_count": %d, "hull_dilate": %d, "threshold": %s, "refine_options": %s,\n' \
+    "$(json_string "$scene")" "$folds" "$dilate" "$(printf '%g' "$threshold")" "$(json_string "${refine_options[*]}")"
   printf '"mean": {"hull": {"mae": %s, "psnr_db": %s, "silhouette_disagreement": %s},\n' "$hm" "$hp" "$hs"
   printf '  "refined": {"mae": %s, "psnr_db": %s, "silhouette_disagreement": %s},\n' "$rm" "$rp" "$rs"
   printf '  "mae_change_percent": %s, "folds_refined_worse": %s},\n"folds": [\n' "$change" "$worse"

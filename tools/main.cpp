@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
   log->set_pattern("[%l] %v");
   log->set_level(verbose ? spdlog::level::debug : spdlog::level::from_str(log_level));
   try {
-    log->debug("photo kernel: {}", mvflow::photo_kernel_summary());  // a bad MVFLOW_KERNEL fails here, before any work
+    const std::string kernel_used = mvflow::photo_kernel_summary();  // a bad MVFLOW_KERNEL fails here, before any work
+    log->debug("photo kernel: {}", kernel_used);
     return runner(*log);
   } catch (const mvflow::Error& e) {
     log->error("{}", e.what());

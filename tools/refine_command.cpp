@@ -221,13 +221,13 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--max-view-angle", o.visibility.max_angle_degrees, "Views beyond this angle to the normal are not used (degrees)")
       ->capture_default_str();
   c->add_option("--max-views", o.visibility.max_views,
-                "Keep only this many visible views per vertex, those closest to the normal (0 = all)")
+                "Keep only this many visible views per vertex, those closest to the normal (0 = all, else >= 2)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   c->add_option("--preferred-view-angle", o.visibility.preferred_angle_degrees,
                 "Views beyond this angle to the normal (up to --max-view-angle) only top a vertex's views up to "
                 "--min-views, the closest first (degrees)")
-      ->check(CLI::Range(1.0, 90.0))
+      ->check(CLI::Range(0.001, 90.0))
       ->capture_default_str();
   c->add_option("--min-views", o.visibility.min_views, "See --preferred-view-angle")
       ->check(CLI::Range(2, 1000))
@@ -256,13 +256,14 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--weak-view-angle", o.unobserved.weak_angle_degrees,
                 "--fill-unobserved on: a vertex whose views all lie beyond this angle to its normal follows its "
                 "neighbours too (degrees; 90 = only vertices without g or ∇g)")
-      ->check(CLI::Range(1.0, 90.0))
+      ->check(CLI::Range(0.001, 90.0))
       ->capture_default_str();
   c->add_option("--smoothing", o.smoothing.lambda_dt, "Curvature-normal smoothing λ·dt per step")->capture_default_str();
   c->add_option("--smoothing-steps", o.smoothing.steps, "Smoothing steps per iteration")->capture_default_str();
   c->add_option("--taubin-pass-band", o.smoothing.taubin_pass_band,
                 "Taubin k_PB: each smoothing step is followed by one with −μ = −λ/(1 − k_PB·λ), so smoothing does "
                 "not shrink the surface (0 = off, the thesis)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   c->add_option("--regularization", o.regularization.strength, "Tangential regularization C per step")->capture_default_str();
   c->add_option("--regularization-steps", o.regularization.steps, "Regularization steps per iteration")->capture_default_str();
