@@ -31,6 +31,21 @@ void commit(const std::filesystem::path& temporary, const std::filesystem::path&
 
 }  // namespace
 
+void check_writable(const std::filesystem::path& destination) {
+  std::error_code error;
+  const auto folder = destination.has_parent_path() ? destination.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(folder, error))
+    throw IoError(destination, "cannot be written: the folder " + folder.string() + " does not exist");
+  if (std::filesystem::is_directory(destination, error))
+    throw IoError(destination, "cannot be written: it is a folder");
+  const auto probe = temporary_beside(destination);
+  {
+    std::ofstream out(probe, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError(destination, "cannot be written: its folder does not take new files");
+  }
+  std::filesystem::remove(probe, error);
+}
+
 void write_atomically_to_path(const std::filesystem::path& destination,
                               const std::function<void(const std::filesystem::path&)>& write) {
   const auto temporary = temporary_beside(destination);

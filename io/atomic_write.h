@@ -19,4 +19,9 @@ void write_atomically(const std::filesystem::path& destination, bool binary,
 void write_atomically_to_path(const std::filesystem::path& destination,
                               const std::function<void(const std::filesystem::path&)>& write);
 
+//! Checks, before any long work, that write_atomically can later write \p destination: its
+//! folder exists and takes a new file (a probe file is created and removed), and the destination
+//! is not a folder. \throw IoError naming \p destination and what is wrong.
+void check_writable(const std::filesystem::path& destination);
+
 }  // namespace mvflow::io

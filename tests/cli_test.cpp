@@ -56,6 +56,27 @@ TEST(Cli, BadInputExitsOneNamingTheFile) {
   EXPECT_EQ(r.output.find("terminate"), std::string::npos) << r.output;
 }
 
+TEST(Cli, RefineChecksItsOutputsBeforeAnyWork) {
+  test::ScratchFolder folder;
+  const std::string scene = kDefaultScene.string();
+  struct Case {
+    std::string arguments, expected;
+  };
+  const Case cases[] = {
+      {"-o " + (folder / "missing" / "x.ply").string(), "does not exist"},
+      {"-o " + (folder / "x.ply").string() + " --report " + (folder / "missing" / "r.json").string(), "r.json"},
+      {"-o " + folder.path().string(), "it is a folder"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = run("refine " + scene + " " + c.arguments);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("refining"), std::string::npos) << "the refinement started: " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(folder / "x.ply"));
+  EXPECT_TRUE(fs::is_empty(folder.path()));  // no probe file left behind
+}
+
 TEST(Cli, NonManifoldMeshIsReportedNotFatal) {
   test::ScratchFolder folder;
   // Three triangles on the edge (0,1).

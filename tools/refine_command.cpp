@@ -8,6 +8,7 @@
 
 #include "engine/error.h"
 #include "engine/refiner.h"
+#include "io/atomic_write.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
@@ -146,6 +147,9 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
 }
 
 int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog::logger& log) {
+  // Before the scene is read: a refinement that cannot write its result is not started.
+  io::check_writable(args.output);
+  if (!args.report.empty()) io::check_writable(args.report);
   const Scene scene = io::load_scene(args.scene);
   std::string mesh_file = args.mesh;
   if (mesh_file.empty() && scene.mesh_file) mesh_file = scene.mesh_file->string();
