@@ -46,6 +46,35 @@ struct PhotoValue {
   bool defined() const { return views >= 2; }
 };
 
+namespace detail {
+
+//! The most values one patch has (half_patch 7: 15 × 15 pixels × RGB).
+inline constexpr int kMaxPatchValues = 3 * 15 * 15;
+
+//! The 3·(2h+1)² values of the patch of \p view around \p X (rows top to bottom, RGB
+//! interleaved), each interpolated in float along the row, then down: h = a + fx·(b − a),
+//! C = h + fy·(h' − h). False (nothing written) when X is behind the camera or the patch with its
+//! bilinear support leaves the image.
+bool read_patch(const PhotoView& view, const Eigen::Vector3d& X, int half_patch, float* out);
+
+//! Σ_i C per patch value and Σ_i Σ_values C² over the views added, in double and in the order
+//! added, and g from them: (Σ C² − Σ_values (Σ_i C)²/m) / ((m − 1)·side²).
+class PatchVariance {
+ public:
+  explicit PatchVariance(int half_patch);
+  void add(const float* patch);
+  PhotoValue finish() const;
+
+ private:
+  int side_;
+  int count_;
+  int views_ = 0;
+  double squares_ = 0.0;
+  double sum_[kMaxPatchValues];
+};
+
+}  // namespace detail
+
 //! g(X) over the views \p view_ids of \p views.
 PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                              const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options = {});

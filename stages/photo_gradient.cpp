@@ -23,6 +23,7 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
   const bool default_patch = photo.half_patch == 2 && !photo.normalize;
   // Buffers for the whole block: no allocation per vertex.
   std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
+  std::vector<ViewGainBias> maps;  // with normalisation, one per visible view
   const auto position = [&](std::uint32_t v) { return to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))); };
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     const std::span<const std::uint16_t> visible = fields.visible(v);
@@ -40,7 +41,7 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
       detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
     } else if (photo.normalize) {
       // One map per view, taken at X, for every sample: g stays smooth along the sample lines.
-      const std::vector<ViewGainBias> maps = gain_bias_at(X, visible, views, photo.half_patch, photo.noise_floor);
+      gain_bias_at(X, visible, views, photo.half_patch, photo.noise_floor, maps);
       for_each_gradient_sample(X, sample_spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
         samples[slot] = normalized_photo_consistency(point, visible, maps, views, photo.half_patch);
         return samples[0].defined();

@@ -53,13 +53,13 @@ namespace {
 
 // The one dispatcher (production and tests alike): MVFLOW_KERNEL when set, else the widest
 // build this CPU runs. Chosen once, on first use.
-const PhotoKernelBuild& choose_build() {
+PhotoKernelBuild choose_build() {
   const std::vector<PhotoKernelBuild> builds = photo_kernel_builds();
   const char* forced = std::getenv("MVFLOW_KERNEL");
-  if (forced == nullptr || *forced == '\0') return *new PhotoKernelBuild(builds.back());  // lives for the program
+  if (forced == nullptr || *forced == '\0') return builds.back();
   std::string runnable;
   for (const PhotoKernelBuild& build : builds) {
-    if (std::strcmp(build.name, forced) == 0) return *new PhotoKernelBuild(build);
+    if (std::strcmp(build.name, forced) == 0) return build;
     runnable += (runnable.empty() ? "" : ", ") + std::string(build.name);
   }
   const bool known = std::strcmp(forced, "baseline") == 0 || std::strcmp(forced, "avx2") == 0 ||
@@ -73,7 +73,7 @@ const PhotoKernelBuild& choose_build() {
 }  // namespace
 
 const PhotoKernelBuild& active_photo_kernel() {
-  static const PhotoKernelBuild& build = choose_build();
+  static const PhotoKernelBuild build = choose_build();
   return build;
 }
 

@@ -11,8 +11,8 @@
 //    one whose removal lowers the variance most; up to `drop` such views are removed, one at a
 //    time, while more than `min_views` remain (a specularity or an occlusion error in one view
 //    no longer holds g up for the others).
-// The patch values are interpolated as in photo_consistency (float, along the row, then down)
-// and the sums are taken in double.
+// The patch values are photo_consistency's (detail::read_patch) and the sums are taken in double
+// (detail::PatchVariance).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -32,10 +32,11 @@ struct ViewGainBias {
   float scale = 1.0f;
 };
 
-//! The maps of the views \p view_ids at \p X (one per id, in the same order; identity for a
-//! view whose patch leaves its image there). \p noise_floor is σ₀ on [0,1] values.
-std::vector<ViewGainBias> gain_bias_at(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
-                                       const std::vector<PhotoView>& views, int half_patch, double noise_floor);
+//! \p maps = the maps of the views \p view_ids at \p X (one per id, in the same order; identity for
+//! a view whose patch leaves its image there). \p noise_floor is σ₀ on [0,1] values. \p maps is
+//! reused: no allocation once it has grown to the view count.
+void gain_bias_at(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
+                  int half_patch, double noise_floor, std::vector<ViewGainBias>& maps);
 
 //! g at \p X over \p view_ids with each view's values mapped by \p maps (same order as the ids).
 PhotoValue normalized_photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,

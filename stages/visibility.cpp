@@ -10,19 +10,17 @@ namespace mvflow {
 
 namespace {
 
-// View selection among the \p count visible views in \p visible (view order): those within the
-// preferred angle, topped up with the closest others to min_views, at most max_views (the closest
-// first; the lower view index on a tie). Rewrites \p visible in view order; returns the count.
-std::uint16_t select_views(const Eigen::Vector3d& P, const Eigen::Vector3d& N, const std::vector<PhotoView>& views,
-                           const VisibilityOptions& options, double cos_preferred, std::uint16_t* visible,
-                           std::uint16_t count, std::vector<std::pair<double, std::uint16_t>>& ranked) {
+// View selection among the \p count visible views in \p visible (view order), whose cosines to
+// the normal are \p cosines: those within the preferred angle, topped up with the closest others
+// to min_views, at most max_views (the closest first; the lower view index on a tie). Rewrites
+// \p visible in view order; returns the count.
+std::uint16_t select_views(const VisibilityOptions& options, double cos_preferred, const double* cosines,
+                           std::uint16_t* visible, std::uint16_t count,
+                           std::vector<std::pair<double, std::uint16_t>>& ranked) {
   const bool preferring = options.preferred_angle_degrees < options.max_angle_degrees;
   if (!preferring && (options.max_views == 0 || count <= options.max_views)) return count;
   ranked.clear();  // (−cos, view): the closest to the normal first
-  for (std::uint16_t k = 0; k < count; ++k) {
-    const Eigen::Vector3d to_camera = views[visible[k]].camera->centre() - P;
-    ranked.emplace_back(-N.dot(to_camera) / to_camera.norm(), visible[k]);
-  }
+  for (std::uint16_t k = 0; k < count; ++k) ranked.emplace_back(-cosines[k], visible[k]);
   std::sort(ranked.begin(), ranked.end());
   std::size_t keep = ranked.size();
   if (preferring) {
@@ -48,6 +46,7 @@ void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vec
   const double offset = options.ray_offset * mean_edge;
   const double cos_preferred = std::cos(options.preferred_angle_degrees * std::numbers::pi / 180.0);
   std::vector<std::pair<double, std::uint16_t>> ranked;
+  std::vector<double> cosines(views.size());  // of the visible views, in their order
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     std::uint16_t* visible = fields.visible_views.data() + v * fields.view_capacity;
     std::uint16_t count = 0;
@@ -65,9 +64,10 @@ void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vec
         if (!(p.depth > 0) || !view.patch_inside(p.u, p.v, options.half_patch)) continue;
         const Eigen::Vector3d from_origin = view.camera->centre() - origin;
         if (surface.occluded(origin, from_origin, 0.0, 1.0)) continue;
+        cosines[count] = N.dot(to_camera) / distance;
         visible[count++] = static_cast<std::uint16_t>(i);
       }
-      count = select_views(P, N, views, options, cos_preferred, visible, count, ranked);
+      count = select_views(options, cos_preferred, cosines.data(), visible, count, ranked);
     }
     fields.visible_count[v] = count;
   }

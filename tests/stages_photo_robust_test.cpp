@@ -263,12 +263,17 @@ TEST(ViewSelection, KeepsTheViewsClosestToTheNormal) {
   EXPECT_GT(cut, 20);
 }
 
-TEST(UnobservedSpeed, AVertexWithoutSpeedMovesWithItsRing) {
-  TriMesh mesh = test::icosphere(1.0, 3);
-  const IndexRange all = test::all_vertices(mesh);
+// Fields for \p mesh with its normals and nothing else defined (no speed anywhere).
+VertexFields fields_with_normals(const TriMesh& mesh) {
   VertexFields fields;
   fields.resize(mesh.n_vertices(), 1);
-  compute_normals(mesh, all, fields);
+  compute_normals(mesh, test::all_vertices(mesh), fields);
+  return fields;
+}
+
+TEST(UnobservedSpeed, AVertexWithoutSpeedMovesWithItsRing) {
+  TriMesh mesh = test::icosphere(1.0, 3);
+  VertexFields fields = fields_with_normals(mesh);
   // Observed: the vertices above z = −0.5, with a normal speed that varies over the sphere;
   // below it, a cap that no view sees.
   std::vector<bool> observed(mesh.n_vertices());
@@ -319,10 +324,7 @@ TEST(UnobservedSpeed, AVertexWithoutSpeedMovesWithItsRing) {
 
 TEST(UnobservedSpeed, OffOrWithoutAnyObservedVertexNothingMoves) {
   TriMesh mesh = test::icosphere(1.0, 2);
-  const IndexRange all = test::all_vertices(mesh);
-  VertexFields fields;
-  fields.resize(mesh.n_vertices(), 1);
-  compute_normals(mesh, all, fields);
+  VertexFields fields = fields_with_normals(mesh);
   const std::vector<double> rate(mesh.n_vertices(), -1.0);
   EXPECT_EQ(fill_unobserved_speeds(mesh, {.fill = true}, rate, fields), 0u);  // nothing observed: nothing to follow
   fields.defined[0] |= kSpeedDefined;
