@@ -12,6 +12,7 @@ void RefineOptions::check() const {
   require(photo.check(), "photo consistency / Savitzky-Golay (k even >= 2, order, patch 1..7, noise floor in [0, 1], "
                          "drop views 0..64, min views >= 2)");
   require(unobserved.check(), "unobserved speed (rings >= 1)");
+  require(unobserved_displacement.check(), "observed view angle in (0, 90]");
   require(speed.check(), "velocity");
   require(cfl > 0 && cfl <= 10, "cfl (0, 10]");
   require(speed_quantile > 0 && speed_quantile <= 1, "speed quantile (0, 1]");
@@ -36,6 +37,8 @@ RefineOptions thesis_preset() {
   options.visibility.preferred_angle_degrees = 90.0;
   options.curvature.area = CurvatureArea::Barycentric;
   options.stopping.epsilon_percent = 0.3;
+  options.stopping.max_iterations = 100;
+  options.stopping.median_move_tolerance = 0.002;
   options.speed_quantile = 1.0;
   options.local_step = false;
   options.step_control = false;

@@ -15,6 +15,7 @@
 #include "stages/smoothing.h"
 #include "stages/speed.h"
 #include "stages/stopping.h"
+#include "stages/unobserved_displacement.h"
 #include "stages/unobserved_speed.h"
 #include "stages/untangling.h"
 #include "stages/visibility.h"
@@ -44,6 +45,9 @@ struct RefineOptions {
   SpeedOptions speed;                  //!< balloon velocity v
   //! Whether vertices without g or ∇g move with their observed neighbours (default: no).
   UnobservedSpeedOptions unobserved;
+  //! Whether the poorly observed vertices take the observed surface's displacement when the
+  //! flow has converged at a resolution and at the end (default: yes; thesis preset: no).
+  UnobservedDisplacementOptions unobserved_displacement;
   //! Δt = cfl·(e/2)/(√3·|F|_q), e the mean edge (local_step) or e_min (SPEC §4; thesis 1)
   double cfl = 1.0;
   //! q, the quantile of |F| over the moving vertices that sets Δt; in (0, 1]. 1 = max|F|, the

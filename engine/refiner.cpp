@@ -26,6 +26,7 @@
 #include "stages/self_intersections.h"
 #include "stages/silhouette_constraint.h"
 #include "stages/smoothing.h"
+#include "stages/unobserved_displacement.h"
 #include "stages/untangling.h"
 #include "stages/visibility.h"
 
@@ -185,6 +186,7 @@ class Refinement {
     }
 
     progress(static_cast<int>(summary.iterations.size()), "finishing");
+    if (status != RefineStatus::Cancelled) spread_unobserved();
     const std::optional<UntanglingResult> untangled =
         status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
     summary.untangled_pairs = untangled_pairs_;
@@ -225,6 +227,7 @@ class Refinement {
     if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
     apply_smoothing(mesh_, options_.smoothing);
     apply_regularization(mesh_, options_.regularization);
+    if (options_.unobserved_displacement.enabled) reference_ = positions_of(mesh_);
   }
 
   // Removes the folds of the current surface (UntanglingOptions), counted for the summary;
@@ -234,18 +237,38 @@ class Refinement {
     const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const UntanglingResult result = untangle(mesh_, options_.untangling);
     untangled_pairs_ += result.crossing_pairs_before - result.crossing_pairs_after;
-    if (inside_ && result.rounds > 0) {  // the silhouette constraint holds for these moves too
-      for (auto v : mesh_.vertices()) {
-        const Eigen::Vector3d& from = before[static_cast<std::size_t>(v.idx())];
-        const Eigen::Vector3d to = to_eigen(mesh_.point(v));
-        if (to != from) mesh_.set_point(v, to_openmesh(inside_->limit_move(from, to)));
-      }
-    }
+    if (result.rounds > 0) limit_to_silhouettes(before);
     if (control_.logger && result.crossing_pairs_before > 0)
       control_.logger->info("untangled {} crossing face pairs ({} left) by smoothing {} vertices in {} rounds",
                             result.crossing_pairs_before, result.crossing_pairs_after, result.smoothed_vertices,
                             result.rounds);
     return result;
+  }
+
+  // The silhouette constraint holds for the moves outside the flow too: each vertex moved since
+  // \p before (its positions then; empty without the constraint) is pulled back inside.
+  void limit_to_silhouettes(const std::vector<Eigen::Vector3d>& before) {
+    if (!inside_) return;
+    for (auto v : mesh_.vertices()) {
+      const Eigen::Vector3d& from = before[static_cast<std::size_t>(v.idx())];
+      const Eigen::Vector3d to = to_eigen(mesh_.point(v));
+      if (to != from) mesh_.set_point(v, to_openmesh(inside_->limit_move(from, to)));
+    }
+  }
+
+  // Moves the vertices the last iteration did not observe well with the observed surface
+  // (UnobservedDisplacementOptions); the fields still describe the current topology.
+  // True when vertices moved.
+  bool spread_unobserved() {
+    if (!options_.unobserved_displacement.enabled) return false;
+    const std::vector<std::uint8_t> poor =
+        poorly_observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement);
+    const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
+    const DisplacementResult result = spread_displacement(mesh_, reference_, poor);
+    if (result.moved_vertices > 0) limit_to_silhouettes(before);
+    if (control_.logger && result.moved_vertices > 0)
+      control_.logger->info("moved {} unobserved vertices with the observed surface", result.moved_vertices);
+    return result.moved_vertices > 0;
   }
 
   // Normals and curvature at the current positions for every vertex (after the untangling moved
@@ -263,6 +286,7 @@ class Refinement {
     const auto start = Clock::now();
     const std::size_t faces = mesh_.n_faces();
     const RefinementResult result = refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
+    if (options_.unobserved_displacement.enabled) extend_reference(reference_, result.parents);
     report.refined_faces += mesh_.n_faces() - faces;
     report.declined_vertices += result.declined;
     seconds += seconds_since(start);
@@ -285,12 +309,14 @@ class Refinement {
     }
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     const auto start = Clock::now();
+    const bool spread = spread_unobserved();
     const std::optional<UntanglingResult> untangled = untangle_folds();
-    if (untangled && untangled->rounds > 0) update_curvature();  // so the marks do not follow a removed fold
+    if (spread || (untangled && untangled->rounds > 0)) update_curvature();  // the marks follow the moves
     double seconds = seconds_since(start);
     const bool refined = adapt(report, seconds);
     report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
     if (!refined) return false;
+    if (options_.unobserved_displacement.enabled) reference_ = positions_of(mesh_);  // this resolution's start
     report.stop = std::string("refined (") + to_string(reason) + ")";
     data_.reset_topology();
     graph_.reset();
@@ -340,6 +366,9 @@ class Refinement {
   double reference_edge_ = 0.0;
   double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
   std::size_t untangled_pairs_ = 0;
+  // Where each vertex was when the flow started (UnobservedDisplacementOptions), midpoints for the
+  // vertices refinement added; empty when the option is off.
+  std::vector<Eigen::Vector3d> reference_;
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
   std::optional<SilhouetteConstraint> inside_;
 };

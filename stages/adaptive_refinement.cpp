@@ -117,6 +117,8 @@ RefinementResult refine_adaptively(TriMesh& mesh, const VertexFields& fields, do
     const auto h = mesh.halfedge_handle(e, 0);
     const auto mid = 0.5 * (mesh.point(mesh.from_vertex_handle(h)) + mesh.point(mesh.to_vertex_handle(h)));
     midpoint[e.idx()] = mesh.add_vertex(mid);
+    result.parents.push_back({static_cast<std::uint32_t>(mesh.from_vertex_handle(h).idx()),
+                              static_cast<std::uint32_t>(mesh.to_vertex_handle(h).idx())});
     ++result.new_vertices;
   }
   if (result.new_vertices == 0) return result;

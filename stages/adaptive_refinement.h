@@ -2,7 +2,10 @@
 // Adaptive refinement around high-curvature vertices: red quadrisection with a conforming
 // red–green closure (thesis 5.3.1, figure 5.1, B.4, B.7; SPEC §5, §9).
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "engine/mesh.h"
 #include "engine/vertex_fields.h"
@@ -41,6 +44,9 @@ struct RefinementResult {
   std::size_t promoted_faces = 0;   //!< of red_faces: closure faces with ≥ 2 split edges
   std::size_t green_faces = 0;      //!< closure faces bisected (1 → 2)
   std::size_t new_vertices = 0;     //!< edge midpoints added (one per split edge)
+  //! The ends of the split edge of each added midpoint, in the order they were appended (new
+  //! vertex #V_before + i is the midpoint of parents[i]).
+  std::vector<std::array<std::uint32_t, 2>> parents;
   //! Midpoints the refinement would have added when it was declined (fewer than
   //! options.min_growth × #V; nothing was changed), else 0.
   std::size_t declined = 0;

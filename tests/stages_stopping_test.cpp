@@ -13,8 +13,11 @@ namespace {
 
 constexpr double large_move = 1.0;  // far above τ: only the Σg rule or the budget can fire
 
-// The thesis's test: every one of the last five changes below ε.
-StoppingOptions each_lookback() { return StoppingOptions{.test = ConvergenceTest::EachLookback}; }
+// The thesis's test (every one of the last five changes below ε) with the thesis preset's budget
+// and SPEC §4's step tolerance.
+StoppingOptions each_lookback() {
+  return StoppingOptions{.test = ConvergenceTest::EachLookback, .max_iterations = 100, .median_move_tolerance = 0.002};
+}
 
 // Feeds \p g and returns the iteration (1-based) at which the criterion stopped, 0 if never.
 std::pair<std::size_t, StopReason> run(const std::vector<double>& g, double move = large_move,
@@ -28,15 +31,15 @@ std::pair<std::size_t, StopReason> run(const std::vector<double>& g, double move
   return {0, StopReason::Continue};
 }
 
-TEST(StoppingOptions, DefaultsFollowTheThesisButForTheConvergenceTest) {
+TEST(StoppingOptions, DefaultsFollowTheThesisButForTheTestTheBudgetAndTheStepTolerance) {
   const StoppingOptions o;
   EXPECT_TRUE(o.check());
   EXPECT_EQ(o.test, ConvergenceTest::NoImprovement);
   EXPECT_EQ(o.epsilon_percent, 0.3);
   EXPECT_EQ(o.min_iterations, 10);
-  EXPECT_EQ(o.max_iterations, 100);
+  EXPECT_EQ(o.max_iterations, 200);
   EXPECT_EQ(o.lookback, 5);
-  EXPECT_EQ(o.median_move_tolerance, 0.002);
+  EXPECT_EQ(o.median_move_tolerance, 0.001);
   EXPECT_FALSE((StoppingOptions{.epsilon_percent = 0.0}).check());
   EXPECT_FALSE((StoppingOptions{.min_iterations = 5}).check());  // needs lookback + 1
   EXPECT_FALSE((StoppingOptions{.max_iterations = 9}).check());

@@ -35,6 +35,7 @@ struct RefineArguments {
   std::string convergence;        // "each-lookback" or "no-improvement"; empty: the preset's
   std::string normalize;          // "on" or "off"; empty: the preset's
   std::string fill_unobserved;    // "on" or "off"; empty: the preset's
+  std::string spread_unobserved;  // "on" or "off"; empty: the preset's
   int threads = 0;
   RefineOptions options;          // values given on the command line override the preset
 };
@@ -61,6 +62,9 @@ nlohmann::json options_json(const RefineOptions& o, const std::string& preset) {
           {"drop_views", o.photo.photo.drop_views},
           {"drop_min_views", o.photo.photo.min_views},
           {"fill_unobserved", o.unobserved.fill},
+          {"spread_unobserved", o.unobserved_displacement.enabled},
+          {"observed_view_angle_degrees", o.unobserved_displacement.observed_angle_degrees},
+          {"observed_erode_rings", o.unobserved_displacement.erode_rings},
           {"weak_view_angle_degrees", o.unobserved.weak_angle_degrees},
           {"curvature_area", o.curvature.area == CurvatureArea::Mixed ? "mixed" : "barycentric"},
           {"smoothing_lambda_dt", o.smoothing.lambda_dt},
@@ -125,7 +129,11 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
   set("--drop-min-views", options.photo.photo.min_views, given.photo.photo.min_views);
   if (!args.normalize.empty()) options.photo.photo.normalize = args.normalize == "on";
   if (!args.fill_unobserved.empty()) options.unobserved.fill = args.fill_unobserved == "on";
+  if (!args.spread_unobserved.empty()) options.unobserved_displacement.enabled = args.spread_unobserved == "on";
   set("--weak-view-angle", options.unobserved.weak_angle_degrees, given.unobserved.weak_angle_degrees);
+  set("--observed-erode", options.unobserved_displacement.erode_rings, given.unobserved_displacement.erode_rings);
+  set("--observed-view-angle", options.unobserved_displacement.observed_angle_degrees,
+      given.unobserved_displacement.observed_angle_degrees);
   set("--sg-order", options.photo.savitzky_golay.order, given.photo.savitzky_golay.order);
   if (command.count("--patch") > 0) {
     options.photo.photo.half_patch = given.photo.photo.half_patch;
@@ -253,6 +261,19 @@ void add_refine_command(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   c->add_option("--drop-min-views", o.photo.photo.min_views, "... while more than this many views remain")
       ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  c->add_option("--spread-unobserved", args->spread_unobserved,
+                "Vertices without g or ∇g take the observed surface's displacement (harmonic, along the starting "
+                "normal) when the flow converges at a resolution and at the end (on/off; default off)")
+      ->check(CLI::IsMember({"on", "off"}));
+  c->add_option("--observed-view-angle", o.unobserved_displacement.observed_angle_degrees,
+                "--spread-unobserved on: a vertex counts as observed when it has a speed and a view within this angle "
+                "of its normal (degrees)")
+      ->check(CLI::Range(0.001, 90.0))
+      ->capture_default_str();
+  c->add_option("--observed-erode", o.unobserved_displacement.erode_rings,
+                "--spread-unobserved on: shrink the observed set by this many rings before following it")
+      ->check(CLI::Range(0, 100))
       ->capture_default_str();
   c->add_option("--fill-unobserved", args->fill_unobserved,
                 "Vertices without g or ∇g move with their observed neighbours (on/off)")
