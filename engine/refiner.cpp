@@ -316,7 +316,6 @@ class Refinement {
     const bool refined = adapt(report, seconds);
     report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
     if (!refined) return false;
-    if (options_.unobserved_displacement.enabled) reference_ = positions_of(mesh_);  // this resolution's start
     report.stop = std::string("refined (") + to_string(reason) + ")";
     data_.reset_topology();
     graph_.reset();

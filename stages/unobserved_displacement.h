@@ -3,7 +3,7 @@
 // (README, "Defaults and differences"). A vertex seen only at grazing angles, occluded or outside
 // every image has no reliable speed, so such a region would keep the initial surface's error
 // while its observed border converges. Here the displacement of the observed vertices from the
-// surface the flow started on, measured along that surface's normal, is spread over the rest
+// surface the flow started on (their signed distance to it) is spread over the rest
 // by the cotangent Laplace equation (a harmonic interpolation: it stays between its boundary
 // values, so the noise of the observed border is averaged, never amplified), and every such
 // vertex is placed at its starting position moved by that amount along its starting normal.
@@ -36,8 +36,8 @@ struct UnobservedDisplacementOptions {
   //! The observed set is shrunk by this many vertex rings before it is followed (a vertex stays
   //! observed only if its whole one ring is, ring by ring): the ragged border of the observed
   //! region and isolated "observed" vertices inside an unobserved one are the least reliable
-  //! (on a sphere whose cap is seen only at grazing angles, 1 ring took the cap's error from
-  //! 0.0046 to 0.0025, README). ≥ 0.
+  //! (on a sphere whose cap is seen only at grazing angles, 0 rings left spikes of 0.03 in the
+  //! cap, 2 or more pulled it in; README, "Quality"). ≥ 0.
   int erode_rings = 1;
 
   bool check() const { return observed_angle_degrees > 0 && observed_angle_degrees <= 90 && erode_rings >= 0; }
