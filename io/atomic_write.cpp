@@ -46,6 +46,13 @@ void check_writable(const std::filesystem::path& destination) {
   std::filesystem::remove(probe, error);
 }
 
+void prepare_output_folder(const std::filesystem::path& folder) {
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw IoError(folder, "cannot be created as the output folder: " + error.message());
+  check_writable(folder / "probe");
+}
+
 void write_atomically_to_path(const std::filesystem::path& destination,
                               const std::function<void(const std::filesystem::path&)>& write) {
   const auto temporary = temporary_beside(destination);

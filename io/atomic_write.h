@@ -24,4 +24,8 @@ void write_atomically_to_path(const std::filesystem::path& destination,
 //! is not a folder. \throw IoError naming \p destination and what is wrong.
 void check_writable(const std::filesystem::path& destination);
 
+//! Creates \p folder (and its parents) if missing and checks that it takes new files, before any
+//! long work that writes into it. \throw IoError naming \p folder and what is wrong.
+void prepare_output_folder(const std::filesystem::path& folder);
+
 }  // namespace mvflow::io

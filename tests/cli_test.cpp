@@ -77,6 +77,40 @@ TEST(Cli, RefineChecksItsOutputsBeforeAnyWork) {
   EXPECT_TRUE(fs::is_empty(folder.path()));  // no probe file left behind
 }
 
+TEST(Cli, EveryCommandChecksItsOutputsBeforeAnyWork) {
+  // A regular file where a folder is expected: no user (root included) can create folders under it.
+  test::ScratchFolder folder;
+  const fs::path blocker = folder / "file";
+  test::write_text(blocker, "not a folder\n");
+  const std::string scene = kDefaultScene.string(), mesh = (kDefaultScene / "init.off").string();
+  test::write_text(folder / "list.txt", scene + "\n");
+  struct Case {
+    std::string arguments, expected, work_started;
+  };
+  const Case cases[] = {
+      {"hull " + scene + " -o " + (blocker / "x.ply").string(), "does not exist", "grid "},
+      {"hull " + scene + " -o " + (folder / "h.ply").string() + " --save-masks " + (blocker / "masks").string(),
+       "cannot be created as the output folder", "grid "},
+      {"batch " + (folder / "list.txt").string() + " -o " + (blocker / "out").string(),
+       "cannot be created as the output folder", "[1/"},
+      {"synth --level 1 --views 2 --width 16 --height 12 -o " + (blocker / "scene").string(),
+       "cannot be created as the output folder", "rendered"},
+      {"eval " + mesh + " " + mesh + " --json " + (blocker / "e.json").string(), "does not exist", "accuracy"},
+      {"heldout " + scene + " " + mesh + " --views 0 --json " + (blocker / "h.json").string(), "does not exist",
+       "scoring"},
+      {"heldout " + scene + " " + mesh + " --views 0 -o " + (blocker / "h").string(),
+       "cannot be created as the output folder", "scoring"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = run(c.arguments);
+    EXPECT_EQ(r.exit_code, 1) << c.arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find(blocker.string()), std::string::npos) << "the error names the location: " << r.output;
+    EXPECT_EQ(r.output.find(c.work_started), std::string::npos) << "the work started: " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(folder / "h.ply"));
+}
+
 TEST(Cli, NonManifoldMeshIsReportedNotFatal) {
   test::ScratchFolder folder;
   // Three triangles on the edge (0,1).

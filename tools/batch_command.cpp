@@ -9,6 +9,7 @@
 
 #include "engine/error.h"
 #include "engine/refiner.h"
+#include "io/atomic_write.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
@@ -142,6 +143,7 @@ int run_batch(const BatchArguments& args, spdlog::logger& log) {
   }
   options.check();
   const std::vector<BatchItem> items = read_items(args.list);
+  io::prepare_output_folder(args.output);  // before the first scene's work, not after it
   std::vector<Row> rows;
   int failed = 0;
   for (std::size_t k = 0; k < items.size(); ++k) {

@@ -28,6 +28,7 @@ nlohmann::json directed_json(const DirectedDistances& d, double diagonal) {
 }
 
 int run_eval(const EvalArguments& args, spdlog::logger& log) {
+  if (!args.json.empty()) io::check_writable(args.json);  // before the sampling, not after it
   const IndexedMesh mesh = io::read_mesh(args.mesh);
   const IndexedMesh truth = io::read_mesh(args.truth);
   const EvaluationResult r = evaluate_against_truth(mesh, truth, args.options);

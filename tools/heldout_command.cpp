@@ -74,6 +74,12 @@ std::string format_psnr(double psnr) {
 int run_heldout(const HeldoutArguments& args, spdlog::logger& log) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
+  // The outputs first: a location that could not be written stops the run before any work.
+  const fs::path json_file = !args.json.empty()     ? fs::path(args.json)
+                             : !args.output.empty() ? fs::path(args.output) / "heldout.json"
+                                                    : fs::path();
+  if (!args.output.empty()) io::prepare_output_folder(args.output);
+  if (!json_file.empty()) io::check_writable(json_file);
   const Scene scene = io::load_scene(args.scene);
   MeshBuildReport build;
   const Mesh mesh = io::load_mesh(args.mesh, &build);
@@ -89,15 +95,6 @@ int run_heldout(const HeldoutArguments& args, spdlog::logger& log) {
   const double setup_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   log.info("scoring {} on {} held-out view(s), coloured from {} view(s)", args.mesh,
            renderer.held_out().size(), renderer.colouring_views().size());
-
-  const fs::path json_file = !args.json.empty()     ? fs::path(args.json)
-                             : !args.output.empty() ? fs::path(args.output) / "heldout.json"
-                                                    : fs::path();
-  if (!args.output.empty()) {
-    std::error_code error;
-    fs::create_directories(args.output, error);
-    if (error) throw IoError(args.output, "cannot create the output folder: " + error.message());
-  }
 
   // The real silhouettes first, so that a missing or mis-sized mask stops the run before any work.
   std::vector<Mask> real_silhouettes;

@@ -12,6 +12,7 @@
 
 #include "engine/error.h"
 #include "engine/mesh_stats.h"
+#include "io/atomic_write.h"
 #include "io/image_io.h"
 #include "io/mask_files.h"
 #include "io/mesh_io.h"
@@ -112,6 +113,8 @@ void save_masks(const std::filesystem::path& folder, const Scene& scene, const s
 
 int run_hull(const HullArguments& args, spdlog::logger& log) {
   io::mesh_format_from_path(args.output);  // a bad extension fails now, not after the carving
+  io::check_writable(args.output);        // ... and so does an output that could not be saved
+  if (!args.save_masks.empty()) io::prepare_output_folder(args.save_masks);
   const auto start = std::chrono::steady_clock::now();
   const Scene scene = io::load_scene(args.scene);
   const BoundingBox box = bounding_box(args, scene, log);

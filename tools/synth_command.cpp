@@ -355,6 +355,7 @@ int run_synth(SynthArguments& args, spdlog::logger& log) {
   const SynthOptions options = to_options(s);
   options.check();
 
+  io::prepare_output_folder(args.output);  // before the rendering, not after it
   const LoadedObject object = load_object(s, log);
   const auto start = std::chrono::steady_clock::now();
   SynthScene scene;
