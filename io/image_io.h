@@ -9,7 +9,15 @@
 
 namespace mvflow::io {
 
-//! \throw IoError when the file does not exist; InputError when it cannot be decoded.
+//! The largest photograph read: this many pixels on a side and in all (2^28 = 268 M pixels,
+//! 3.2 GB as float RGB). A PNG or JPEG beyond them is refused from its header, before anything is
+//! allocated; other formats after decoding (the program also sets OpenCV's own decoding limit,
+//! CV_IO_MAX_IMAGE_PIXELS, to kMaxImagePixels unless the environment sets it).
+inline constexpr int kMaxImageSide = 32768;
+inline constexpr long long kMaxImagePixels = 1LL << 28;
+
+//! \throw IoError when the file does not exist; InputError when it cannot be decoded or is larger
+//!        than kMaxImageSide / kMaxImagePixels.
 Image read_image(const std::filesystem::path& file);
 
 struct ImageSize {

@@ -90,6 +90,61 @@ TEST(ImageIo, UnreadableAndMissingFilesAreClearErrors) {
   EXPECT_THROW(io::read_image(folder / "absent.png"), IoError);
 }
 
+// A PNG signature and IHDR chunk stating \p width × \p height (no pixel data follows).
+std::string png_header(std::uint32_t width, std::uint32_t height) {
+  std::string bytes = "\x89PNG\r\n\x1a\n";
+  bytes += std::string("\0\0\0\x0d", 4) + "IHDR";
+  for (const std::uint32_t v : {width, height})
+    for (int shift = 24; shift >= 0; shift -= 8) bytes += static_cast<char>((v >> shift) & 0xFF);
+  bytes += std::string("\x08\x02\0\0\0", 5) + std::string(4, '\0');  // 8-bit RGB; CRC not checked
+  return bytes;
+}
+
+// A JPEG start of image and a baseline start-of-frame segment stating \p width × \p height.
+std::string jpeg_header(int width, int height) {
+  std::string bytes = "\xFF\xD8\xFF\xC0";
+  bytes += std::string("\0\x11\x08", 3);
+  for (const int v : {height, width}) bytes += static_cast<char>((v >> 8) & 0xFF), bytes += static_cast<char>(v & 0xFF);
+  return bytes + std::string(12, '\0');
+}
+
+TEST(ImageIo, ImagesBeyondTheLimitsAreRefusedFromTheirHeader) {
+  test::ScratchFolder folder;
+  struct Case {
+    std::string name, bytes, size;
+  };
+  const Case cases[] = {
+      {"wide.png", png_header(100000, 100), "100000x100"},
+      {"many.png", png_header(20000, 20000), "20000x20000"},  // each side allowed, 4e8 pixels not
+      {"absurd.png", png_header(0xFFFFFFF0u, 0xFFFFFFF0u), "4294967280x4294967280"},
+      {"wide.jpg", jpeg_header(40000, 100), "40000x100"},
+  };
+  for (const Case& c : cases) {
+    test::write_text(folder / c.name, c.bytes);
+    for (int size_only = 0; size_only < 2; ++size_only) {
+      try {
+        if (size_only) {
+          io::read_image_size(folder / c.name);
+        } else {
+          io::read_image(folder / c.name);
+        }
+        FAIL() << c.name << ": expected InputError";
+      } catch (const InputError& e) {
+        // Refused for its size (no pixel data follows the header: decoding would fail otherwise).
+        const std::string message = e.what();
+        EXPECT_NE(message.find(c.name), std::string::npos) << message;
+        EXPECT_NE(message.find("the image is " + c.size + " pixels; at most 32768 on a side"), std::string::npos)
+            << message;
+      }
+    }
+  }
+  // Within the limits the header's size is read without decoding.
+  test::write_text(folder / "fine.png", png_header(32768, 8192));
+  const io::ImageSize fine = io::read_image_size(folder / "fine.png");
+  EXPECT_EQ(fine.width, 32768);
+  EXPECT_EQ(fine.height, 8192);
+}
+
 TEST(ImageIo, FailedWriteLeavesExistingFileIntact) {
   test::ScratchFolder folder;
   const auto file = folder / "keep.png";
