@@ -15,6 +15,7 @@
 #include "io/scene_io.h"
 #include "io/text_reader.h"
 #include "tools/commands.h"
+#include "tools/interrupt.h"
 
 namespace mvflow::cli {
 
@@ -113,6 +114,7 @@ Row refine_one(const BatchItem& item, const fs::path& folder, const RefineOption
     const Mesh initial = io::load_mesh(mesh_file);
     RefineControl control;
     control.threads = args.threads;
+    control.cancel = &interrupt_requested();
     const RefineResult result = refine_mesh(scene, initial, options, control);
     const RefineSummary& s = result.summary;
     row.iterations = s.iterations.size();
@@ -121,6 +123,10 @@ Row refine_one(const BatchItem& item, const fs::path& folder, const RefineOption
     row.g_after = s.final_sum_g_per_vertex;
     row.seconds = s.seconds;
     if (s.status == RefineStatus::Failed) throw Error(s.message);
+    if (s.status == RefineStatus::Cancelled) {  // nothing written: the next batch redoes this scene
+      row.status = "interrupted";
+      return row;
+    }
     fs::create_directories(folder);
     io::write_mesh(folder / "refined.ply", to_indexed(result.mesh));
     // The report last: its presence marks the folder complete.
@@ -135,6 +141,7 @@ Row refine_one(const BatchItem& item, const fs::path& folder, const RefineOption
 }
 
 int run_batch(const BatchArguments& args, spdlog::logger& log) {
+  install_interrupt_handlers();
   const auto [shard, shards] = parse_shard(args.shard);
   RefineOptions options = preset(args.preset);
   if (args.max_iterations > 0) {
@@ -154,9 +161,11 @@ int run_batch(const BatchArguments& args, spdlog::logger& log) {
       rows.push_back({item.name, "skipped (complete)", 0, 0, 0, 0, 0, ""});
       continue;
     }
+    if (interrupt_requested()) break;
     log.info("[{}/{}] {}", k + 1, items.size(), item.scene.string());
     rows.push_back(refine_one(item, folder, options, args, log));
     failed += rows.back().status == "failed";
+    if (interrupt_requested()) break;  // this scene's work is not saved; the rest are not started
   }
   fmt::print("{:<28} {:<20} {:>6} {:>9} {:>12} {:>12} {:>8}\n", "scene", "status", "iter", "vertices", "g/vertex in",
              "g/vertex out", "seconds");
@@ -164,6 +173,10 @@ int run_batch(const BatchArguments& args, spdlog::logger& log) {
     fmt::print("{:<28} {:<20} {:>6} {:>9} {:>12.5g} {:>12.5g} {:>8.2f}{}\n", r.name, r.status, r.iterations, r.vertices,
                r.g_before, r.g_after, r.seconds, r.message.empty() ? "" : "  " + r.message);
   fmt::print("{} scene(s) in shard {}/{}: {} failed\n", rows.size(), shard, shards, failed);
+  if (interrupt_requested()) {
+    log.warn("interrupted: the scenes not marked complete are redone by the next batch");
+    return kInterrupted;
+  }
   return failed > 0 ? kFailure : kOk;
 }
 

@@ -9,8 +9,9 @@
 
 namespace mvflow::cli {
 
-//! Exit codes: 0 ok, 1 bad input or failure, 2 bad usage.
-enum ExitCode : int { kOk = 0, kFailure = 1, kUsage = 2 };
+//! Exit codes: 0 ok, 1 bad input or failure, 2 bad usage, 130 stopped by SIGINT or SIGTERM
+//! (128 + SIGINT, the shells' convention; tools/interrupt.h).
+enum ExitCode : int { kOk = 0, kFailure = 1, kUsage = 2, kInterrupted = 130 };
 
 using Runner = std::function<int(spdlog::logger& log)>;
 

@@ -14,6 +14,7 @@
 #include "io/scene_io.h"
 #include "stages/photo_kernel.h"
 #include "tools/commands.h"
+#include "tools/interrupt.h"
 
 namespace mvflow::cli {
 
@@ -155,6 +156,7 @@ RefineOptions resolve_options(const RefineArguments& args, CLI::App& command) {
 }
 
 int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog::logger& log) {
+  install_interrupt_handlers();
   // Before the scene is read: a refinement that cannot write its result is not started.
   io::check_writable(args.output);
   if (!args.report.empty()) io::check_writable(args.report);
@@ -173,6 +175,7 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   RefineControl control;
   control.threads = args.threads;
   control.logger = shared_log;
+  control.cancel = &interrupt_requested();
   const bool live = isatty(fileno(stderr)) != 0;
   control.on_progress = [live](const RefineProgress& p) {
     if (live)
@@ -184,6 +187,10 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   const RefineResult result = refine_mesh(scene, initial, options, control);
   if (live) std::fprintf(stderr, "\r\033[K");
   const RefineSummary& s = result.summary;
+  if (s.status == RefineStatus::Cancelled) {
+    log.warn("interrupted after {} iterations: nothing written", s.iterations.size());
+    return kInterrupted;
+  }
   if (!args.report.empty()) {
     const nlohmann::json inputs = {{"scene", scene.folder.string()}, {"mesh", mesh_file}, {"views", scene.size()},
                                    {"photo_kernel", detail::active_photo_kernel().name},
