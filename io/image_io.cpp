@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <fstream>
+#include <vector>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -124,8 +125,12 @@ void write_png(const std::filesystem::path& file, const Image& image, int bits) 
   cv::Mat out;
   const double scale = bits == 8 ? 255.0 : 65535.0;
   bgr.convertTo(out, bits == 8 ? CV_8UC3 : CV_16UC3, scale);  // saturates: clamps to [0,1]
-  write_atomically_to_path(file, [&](const std::filesystem::path& temporary) {
-    if (!cv::imwrite(temporary.string(), out)) throw IoError(file, "cannot write PNG");
+  // Encoded in memory and written through a checked stream: cv::imwrite reports success on a
+  // full disk and leaves an empty file.
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(".png", out, bytes)) throw IoError(file, "cannot encode the PNG");
+  write_atomically(file, true, [&](std::ostream& stream) {
+    stream.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   });
 }
 

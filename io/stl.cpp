@@ -4,6 +4,7 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 #include <fstream>
+#include <sstream>
 
 #include "engine/error.h"
 #include "io/atomic_write.h"
@@ -51,19 +52,22 @@ IndexedMesh read_stl(const std::filesystem::path& file) {
 }
 
 void write_stl(const std::filesystem::path& file, const IndexedMesh& mesh, const MeshWriteOptions& options) {
-  write_atomically_to_path(file, [&](const std::filesystem::path& temporary) {
-    mesh.validate(file.string());
-    const TriMesh soup = to_triangle_soup(mesh);
-    OpenMesh::IO::Options om_options;
-    if (options.binary) om_options += OpenMesh::IO::Options::Binary;
-    bool ok = false;
-    {
-      QuietOpenMesh quiet;
-      // STL stores floats: 9 significant digits make the ASCII form exact for them.
-      ok = OpenMesh::IO::write_mesh(soup, temporary.string(), om_options, 9);
-    }
-    if (!ok) throw IoError(file, "cannot write the STL file (OpenMesh failed; does the folder exist?)");
-  });
+  mesh.validate(file.string());
+  const TriMesh soup = to_triangle_soup(mesh);
+  OpenMesh::IO::Options om_options;
+  if (options.binary) om_options += OpenMesh::IO::Options::Binary;
+  // Into memory, then through a checked stream: OpenMesh's file writer reports success on a full
+  // disk and leaves an empty file.
+  std::ostringstream encoded(std::ios::binary);
+  bool ok = false;
+  {
+    QuietOpenMesh quiet;
+    // STL stores floats: 9 significant digits make the ASCII form exact for them.
+    ok = OpenMesh::IO::write_mesh(soup, encoded, ".stl", om_options, 9);
+  }
+  if (!ok) throw IoError(file, "cannot encode the STL file (OpenMesh failed)");
+  const std::string bytes = encoded.str();
+  write_atomically(file, options.binary, [&](std::ostream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); });
 }
 
 }  // namespace mvflow::io
