@@ -1,0 +1,266 @@
+#include "tools/refine_option_table.h"
+
+#include <type_traits>
+#include <utility>
+
+namespace mvflow::cli {
+
+namespace {
+
+// What --help shows as each option's default.
+const RefineOptions& defaults() {
+  static const RefineOptions options = default_preset();
+  return options;
+}
+
+// The field an entry sets, for a const or a mutable RefineOptions: a generic lambda such as
+// [](auto& o) -> auto& { return o.cfl; }.
+template <typename Get>
+using FieldType = std::remove_cvref_t<decltype(std::declval<Get>()(std::declval<RefineOptions&>()))>;
+
+// A numeric (or other single-value) field set from the flag's value.
+template <typename Get>
+RefineOptionEntry value(std::string flag, std::string key, std::string help, Get get,
+                        std::optional<CLI::Validator> check = std::nullopt) {
+  using T = FieldType<Get>;
+  return {flag, key,
+          [=](CLI::App& command) {
+            CLI::Option* option = command.add_option(flag, help)
+                                      ->type_name(CLI::detail::type_name<T>())
+                                      ->default_str(CLI::detail::to_string(get(defaults())));
+            if (check) option->check(*check);
+            return option;
+          },
+          [=](const CLI::Option& given, RefineOptions& target) { get(target) = given.as<T>(); },
+          [=](const RefineOptions& options) { return nlohmann::json(get(options)); }};
+}
+
+// How a choice appears in the report: by its name, or as the field's own value (bool fields).
+enum class ReportAs { Name, Value };
+
+// A field set from one of a few names.
+template <typename Get>
+RefineOptionEntry choice(std::string flag, std::string key, std::string help,
+                         std::vector<std::pair<std::string, FieldType<Get>>> names, Get get,
+                         ReportAs report = ReportAs::Name) {
+  auto name_of = [names](const FieldType<Get>& v) {
+    for (const auto& [name, value] : names)
+      if (value == v) return name;
+    return std::string("?");
+  };
+  std::vector<std::string> allowed;
+  for (const auto& entry : names) allowed.push_back(entry.first);
+  return {flag, key,
+          [=](CLI::App& command) {
+            return command.add_option(flag, help)
+                ->type_name("TEXT")
+                ->check(CLI::IsMember(allowed))
+                ->default_str(name_of(get(defaults())));
+          },
+          [=](const CLI::Option& given, RefineOptions& target) {
+            const std::string name = given.as<std::string>();
+            for (const auto& [candidate, value] : names)
+              if (candidate == name) get(target) = value;
+          },
+          [=](const RefineOptions& options) {
+            return report == ReportAs::Name ? nlohmann::json(name_of(get(options))) : nlohmann::json(get(options));
+          }};
+}
+
+// "on" or "off" for a bool field, reported as the bool.
+template <typename Get>
+RefineOptionEntry on_off(std::string flag, std::string key, std::string help, Get get) {
+  return choice(std::move(flag), std::move(key), std::move(help), {{"on", true}, {"off", false}}, get, ReportAs::Value);
+}
+
+// A flag without a value that sets a bool field to \p when_given.
+template <typename Get>
+RefineOptionEntry switch_flag(std::string flag, std::string key, std::string help, Get get, bool when_given) {
+  return {flag, key, [=](CLI::App& command) { return command.add_flag(flag, help); },
+          [=](const CLI::Option&, RefineOptions& target) { get(target) = when_given; },
+          [=](const RefineOptions& options) { return nlohmann::json(get(options)); }};
+}
+
+std::vector<RefineOptionEntry> make_table() {
+  using R = RefineOptions;
+  std::vector<RefineOptionEntry> t;
+  t.push_back(choice("--engine", "engine", "graph (TBB flow graph) or sequential (reference loop, one thread)",
+                     {{"graph", EngineKind::Graph}, {"sequential", EngineKind::Sequential}},
+                     [](auto& o) -> auto& { return o.engine; }));
+  t.push_back(value("--block-size", "block_size", "Vertices per block (graph node)",
+                    [](auto& o) -> auto& { return o.block_size; }, CLI::PositiveNumber));
+  t.push_back(value("--velocity", "velocity", "Balloon velocity v of the speed g(v+H)",
+                    [](auto& o) -> auto& { return o.speed.velocity; }));
+  t.push_back(value("--cfl", "cfl", "CFL factor of the time step", [](auto& o) -> auto& { return o.cfl; }));
+  t.push_back(value("--speed-quantile", "speed_quantile",
+                    "Quantile of |F| that sets the time step (1 = max, the thesis); faster vertices move the CFL distance",
+                    [](auto& o) -> auto& { return o.speed_quantile; }));
+  // The patch sets the photo consistency's and the visibility's half size together.
+  t.push_back({"--patch", "patch",
+               [](CLI::App& command) {
+                 return command.add_option("--patch", "Patch half size (2 = 5×5)")
+                     ->type_name("INT")
+                     ->check(CLI::Range(1, 7))
+                     ->default_str(std::to_string(defaults().photo.photo.half_patch));
+               },
+               [](const CLI::Option& given, R& target) {
+                 target.photo.photo.half_patch = target.visibility.half_patch = given.as<int>();
+               },
+               [](const R& o) { return nlohmann::json(2 * o.photo.photo.half_patch + 1); }});
+  t.push_back(value("--sg-k", "savitzky_golay_k", "Savitzky–Golay k (window k+1 samples per axis)",
+                    [](auto& o) -> auto& { return o.photo.savitzky_golay.k; }));
+  t.push_back(value("--sg-order", "savitzky_golay_order", "Savitzky–Golay polynomial order",
+                    [](auto& o) -> auto& { return o.photo.savitzky_golay.order; }));
+  t.push_back(choice("--curvature-area", "curvature_area",
+                     "Area of the mean-curvature operator: mixed (Meyer et al.) or barycentric (the thesis)",
+                     {{"mixed", CurvatureArea::Mixed}, {"barycentric", CurvatureArea::Barycentric}},
+                     [](auto& o) -> auto& { return o.curvature.area; }));
+  t.push_back(value("--max-view-angle", "max_view_angle_degrees",
+                    "Views beyond this angle to the normal are not used (degrees)",
+                    [](auto& o) -> auto& { return o.visibility.max_angle_degrees; }));
+  t.push_back(value("--max-views", "max_views",
+                    "Keep only this many visible views per vertex, those closest to the normal (0 = all, else >= 2)",
+                    [](auto& o) -> auto& { return o.visibility.max_views; }, CLI::NonNegativeNumber));
+  t.push_back(value("--preferred-view-angle", "preferred_view_angle_degrees",
+                    "Views beyond this angle to the normal (up to --max-view-angle) only top a vertex's views up to "
+                    "--min-views, the closest first (degrees)",
+                    [](auto& o) -> auto& { return o.visibility.preferred_angle_degrees; }, CLI::Range(0.001, 90.0)));
+  t.push_back(value("--min-views", "min_views", "See --preferred-view-angle",
+                    [](auto& o) -> auto& { return o.visibility.min_views; }, CLI::Range(2, 1000)));
+  t.push_back(value("--image-levels", "image_levels",
+                    "Start on the photographs halved this many times, one level finer each time the flow settles",
+                    [](auto& o) -> auto& { return o.image_levels; }, CLI::Range(0, 4)));
+  t.push_back(on_off("--normalize", "photo_normalize",
+                     "Per-view gain/bias normalisation of the patches before the variance (on/off)",
+                     [](auto& o) -> auto& { return o.photo.photo.normalize; }));
+  t.push_back(value("--noise-floor", "photo_noise_floor",
+                    "Normalisation: contrast floor σ₀ on [0,1] values (flat patches are not stretched beyond it)",
+                    [](auto& o) -> auto& { return o.photo.photo.noise_floor; }, CLI::Range(0.0, 1.0)));
+  t.push_back(value("--drop-views", "drop_views",
+                    "Drop up to this many outlier views per vertex (the patches farthest from the mean)",
+                    [](auto& o) -> auto& { return o.photo.photo.drop_views; }, CLI::Range(0, 64)));
+  t.push_back(value("--drop-min-views", "drop_min_views", "... while more than this many views remain",
+                    [](auto& o) -> auto& { return o.photo.photo.min_views; }, CLI::Range(2, 1000)));
+  t.push_back(on_off("--spread-unobserved", "spread_unobserved",
+                     "Vertices without g or ∇g take the observed surface's displacement (harmonic, from the surface "
+                     "the flow started on) when the flow converges at a resolution and at the end (on/off)",
+                     [](auto& o) -> auto& { return o.unobserved_displacement.enabled; }));
+  t.push_back(value("--observed-view-angle", "observed_view_angle_degrees",
+                    "--spread-unobserved on: a vertex counts as observed when it has a speed and a view within this "
+                    "angle of its normal (degrees)",
+                    [](auto& o) -> auto& { return o.unobserved_displacement.observed_angle_degrees; },
+                    CLI::Range(0.001, 90.0)));
+  t.push_back(value("--observed-erode", "observed_erode_rings",
+                    "--spread-unobserved on: shrink the observed set by this many rings before following it",
+                    [](auto& o) -> auto& { return o.unobserved_displacement.erode_rings; }, CLI::Range(0, 100)));
+  t.push_back(on_off("--fill-unobserved", "fill_unobserved",
+                     "Vertices without g or ∇g move with their observed neighbours (on/off)",
+                     [](auto& o) -> auto& { return o.unobserved.fill; }));
+  t.push_back(value("--weak-view-angle", "weak_view_angle_degrees",
+                    "--fill-unobserved on: a vertex whose views all lie beyond this angle to its normal follows its "
+                    "neighbours too (degrees; 90 = only vertices without g or ∇g)",
+                    [](auto& o) -> auto& { return o.unobserved.weak_angle_degrees; }, CLI::Range(0.001, 90.0)));
+  t.push_back(value("--smoothing", "smoothing_lambda_dt", "Curvature-normal smoothing λ·dt per step",
+                    [](auto& o) -> auto& { return o.smoothing.lambda_dt; }));
+  t.push_back(value("--smoothing-steps", "smoothing_steps", "Smoothing steps per iteration",
+                    [](auto& o) -> auto& { return o.smoothing.steps; }));
+  t.push_back(value("--taubin-pass-band", "smoothing_taubin_pass_band",
+                    "Taubin k_PB: each smoothing step is followed by one with −μ = −λ/(1 − k_PB·λ), so smoothing does "
+                    "not shrink the surface (0 = off, the thesis)",
+                    [](auto& o) -> auto& { return o.smoothing.taubin_pass_band; }, CLI::NonNegativeNumber));
+  t.push_back(value("--regularization", "regularization_strength", "Tangential regularization C per step",
+                    [](auto& o) -> auto& { return o.regularization.strength; }));
+  t.push_back(value("--regularization-steps", "regularization_steps", "Regularization steps per iteration",
+                    [](auto& o) -> auto& { return o.regularization.steps; }));
+  t.push_back(value("--epsilon", "epsilon_percent", "Stop when Σg changes less than this (percent) over 5 iterations",
+                    [](auto& o) -> auto& { return o.stopping.epsilon_percent; }));
+  t.push_back(value("--min-iterations", "min_iterations", "No stop before this iteration",
+                    [](auto& o) -> auto& { return o.stopping.min_iterations; }));
+  t.push_back(value("--max-iterations", "max_iterations", "Stop after this many iterations (over all resolutions)",
+                    [](auto& o) -> auto& { return o.stopping.max_iterations; }));
+  t.push_back(value("--step-tolerance", "median_move_tolerance", "Stop when the median move is below this × e_min",
+                    [](auto& o) -> auto& { return o.stopping.median_move_tolerance; }));
+  t.push_back(switch_flag("--no-remeshing", "global_remeshing", "Skip the global split/collapse before the flow",
+                          [](auto& o) -> auto& { return o.global_remeshing; }, false));
+  t.push_back(value("--refine-min-pixels", "adaptive_min_edge_pixels",
+                    "Adaptive refinement leaves faces with an edge shorter than this many pixels at the object",
+                    [](auto& o) -> auto& { return o.adaptive.min_edge_pixels; }));
+  t.push_back(value("--refine-curvature", "adaptive_curvature_factor",
+                    "Adaptive refinement marks vertices whose curvature-normal length exceeds this × e_S",
+                    [](auto& o) -> auto& { return o.adaptive.curvature_factor; }));
+  t.push_back(value("--untangle-rounds", "untangle_rounds",
+                    "Rounds of fold removal (smoothing around crossing faces) before each refinement and at the end; "
+                    "0 disables (thesis preset)",
+                    [](auto& o) -> auto& { return o.untangling.max_rounds; }));
+  t.push_back(value("--refine-min-growth", "adaptive_min_growth",
+                    "A refinement that would add fewer than this fraction of the vertices is not done (coarse to "
+                    "fine, the run then ends; thesis preset: 0)",
+                    [](auto& o) -> auto& { return o.adaptive.min_growth; }));
+  t.push_back(choice("--refine-when", "refine_when",
+                     "Adaptive refinement before every iteration (the thesis) or when the flow has converged at the "
+                     "current resolution (thesis preset: iteration)",
+                     {{"iteration", RefinementSchedule::EveryIteration}, {"converged", RefinementSchedule::AtConvergence}},
+                     [](auto& o) -> auto& { return o.refinement_schedule; }));
+  t.push_back(choice("--convergence", "convergence_test",
+                     "Σg convergence test: each-lookback (the thesis: every one of the last 5 changes below ε) or "
+                     "no-improvement (the best Σg of the last 5 iterations is not ε below the best before)",
+                     {{"each-lookback", ConvergenceTest::EachLookback}, {"no-improvement", ConvergenceTest::NoImprovement}},
+                     [](auto& o) -> auto& { return o.stopping.test; }));
+  t.push_back(choice("--step", "local_step",
+                     "CFL bound: local (Δt from the mean edge, each vertex moves at most cfl/(2√3) of its own "
+                     "shortest edge) or global (the thesis: every vertex within cfl/(2√3) of the mesh's shortest edge)",
+                     {{"local", true}, {"global", false}}, [](auto& o) -> auto& { return o.local_step; },
+                     ReportAs::Value));
+  t.push_back(on_off("--step-control", "step_control",
+                     "Halve the steps after an iteration that raised Σg/vertex, grow them back after one that lowered it",
+                     [](auto& o) -> auto& { return o.step_control; }));
+  t.push_back(switch_flag("--keep-inside-silhouettes", "keep_inside_silhouettes",
+                          "Keep the surface inside the visual hull of the used views' silhouettes (photographs on a "
+                          "dark background)",
+                          [](auto& o) -> auto& { return o.keep_inside_silhouettes; }, true));
+  t.push_back(value("--silhouette-threshold", "silhouette_threshold",
+                    "Silhouettes for --keep-inside-silhouettes: largest channel above this (on [0,1])",
+                    [](auto& o) -> auto& { return o.silhouettes.threshold; }));
+  t.push_back(value("--silhouette-dilate", "silhouette_dilate", "... dilated by this many pixels",
+                    [](auto& o) -> auto& { return o.silhouettes.dilate; }));
+  t.push_back(switch_flag("--no-adaptive", "adaptive_refinement", "Skip adaptive refinement between iterations",
+                          [](auto& o) -> auto& { return o.adaptive_refinement; }, false));
+  t.push_back({"--exclude-views", "excluded_views",
+               [](CLI::App& command) {
+                 return command.add_option("--exclude-views", "0-based views not to use (held out)")
+                     ->type_name("INT")
+                     ->expected(1, CLI::detail::expected_max_vector_size)
+                     ->delimiter(',');
+               },
+               [](const CLI::Option& given, R& target) { target.excluded_views = given.as<std::vector<int>>(); },
+               [](const R& o) { return nlohmann::json(o.excluded_views); }});
+  return t;
+}
+
+}  // namespace
+
+const std::vector<RefineOptionEntry>& refine_option_table() {
+  static const std::vector<RefineOptionEntry> table = make_table();
+  return table;
+}
+
+void add_refine_options(CLI::App& command) {
+  for (const RefineOptionEntry& entry : refine_option_table()) entry.add(command);
+}
+
+RefineOptions resolve_refine_options(const std::string& preset_name, const CLI::App& command) {
+  RefineOptions options = preset(preset_name);
+  for (const RefineOptionEntry& entry : refine_option_table()) {
+    const CLI::Option* given = command.get_option_no_throw(entry.flag);
+    if (given && given->count() > 0) entry.apply(*given, options);
+  }
+  return options;
+}
+
+nlohmann::json refine_options_json(const RefineOptions& options, const std::string& preset_name) {
+  nlohmann::json json = {{"preset", preset_name}};
+  for (const RefineOptionEntry& entry : refine_option_table()) json[entry.key] = entry.value(options);
+  return json;
+}
+
+}  // namespace mvflow::cli

@@ -1,0 +1,42 @@
+#pragma once
+// Every option of `mvflow refine` that sets a RefineOptions field, declared once: its flag, its
+// key in the report's "options", the field it sets, its valid values and its help. Registration on
+// the command line, applying what the user gave over the preset, and the report all walk this one
+// table, so a flag cannot be registered under one name and read under another.
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "engine/refine_options.h"
+
+namespace mvflow::cli {
+
+struct RefineOptionEntry {
+  std::string flag;  //!< e.g. "--cfl"
+  std::string key;   //!< e.g. "cfl" in the report's "options"
+  //! Registers the flag on \p command with its help, its check and, for --help, the default
+  //! preset's value.
+  std::function<CLI::Option*(CLI::App& command)> add;
+  //! Sets the field of \p target from what the user gave (called only when the flag was given).
+  std::function<void(const CLI::Option& given, RefineOptions& target)> apply;
+  //! The field's value in \p options, as the report writes it.
+  std::function<nlohmann::json(const RefineOptions& options)> value;
+};
+
+//! The table, in the order of `mvflow refine --help`.
+const std::vector<RefineOptionEntry>& refine_option_table();
+
+//! Registers every entry's flag on \p command.
+void add_refine_options(CLI::App& command);
+
+//! The preset \p preset_name with every option the user gave on \p command applied (ranges are
+//! checked by the flags' validators and by RefineOptions::check when the refinement starts).
+RefineOptions resolve_refine_options(const std::string& preset_name, const CLI::App& command);
+
+//! {"preset": NAME, KEY: value...} for every entry.
+nlohmann::json refine_options_json(const RefineOptions& options, const std::string& preset_name);
+
+}  // namespace mvflow::cli
