@@ -43,7 +43,7 @@ class ImageStore {
 struct Scene {
   std::filesystem::path folder;          //!< the scene folder
   std::filesystem::path camera_file;     //!< the file the views came from
-  std::string camera_format;             //!< "colmap", "middlebury" or "photomodeler"
+  std::string camera_format;             //!< "colmap", "colmap-bin", "middlebury" or "photomodeler"
   std::vector<View> views;               //!< in the order of the camera file
   std::shared_ptr<ImageStore> images;    //!< one image per view
   std::optional<std::filesystem::path> mesh_file;  //!< initial mesh found in the folder, if any

@@ -1,5 +1,5 @@
-// Dispatch between the camera formats; the formats themselves live in middlebury.cpp, colmap.cpp
-// and photomodeler.cpp.
+// Dispatch between the camera formats; the formats themselves live in middlebury.cpp, colmap.cpp,
+// colmap_binary.cpp and photomodeler.cpp.
 
 #include "io/camera_io.h"
 
@@ -13,6 +13,8 @@ std::vector<View> read_cameras(const std::filesystem::path& path, CameraFormat f
       return read_middlebury(path);
     case CameraFormat::Colmap:
       return read_colmap(path);
+    case CameraFormat::ColmapBinary:
+      return read_colmap_binary(path);
     case CameraFormat::PhotoModeler:
       return read_photomodeler(path);
   }
@@ -26,6 +28,8 @@ void write_cameras(const std::filesystem::path& path, const std::vector<View>& v
       return write_middlebury(path, views);
     case CameraFormat::Colmap:
       return write_colmap(path, views);
+    case CameraFormat::ColmapBinary:
+      return write_colmap_binary(path, views);
     case CameraFormat::PhotoModeler:
       return write_photomodeler(path, views);
   }
@@ -33,9 +37,11 @@ void write_cameras(const std::filesystem::path& path, const std::vector<View>& v
 }
 
 CameraFormat camera_format_from_name(const std::string& name) {
-  for (CameraFormat format : {CameraFormat::Middlebury, CameraFormat::Colmap, CameraFormat::PhotoModeler})
+  for (CameraFormat format :
+       {CameraFormat::Middlebury, CameraFormat::Colmap, CameraFormat::ColmapBinary, CameraFormat::PhotoModeler})
     if (name == camera_format_name(format)) return format;
-  throw InputError("unknown camera format '" + name + "' (expected middlebury, colmap or photomodeler)");
+  throw InputError("unknown camera format '" + name +
+                   "' (expected middlebury, colmap, colmap-bin or photomodeler)");
 }
 
 const char* camera_format_name(CameraFormat format) {
@@ -44,6 +50,8 @@ const char* camera_format_name(CameraFormat format) {
       return "middlebury";
     case CameraFormat::Colmap:
       return "colmap";
+    case CameraFormat::ColmapBinary:
+      return "colmap-bin";
     case CameraFormat::PhotoModeler:
       return "photomodeler";
   }

@@ -20,13 +20,6 @@ bool has_suffix(const std::string& name, const std::string& suffix) {
   return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-std::optional<fs::path> colmap_folder(const fs::path& folder) {
-  for (const fs::path& candidate : {folder, folder / "sparse", folder / "sparse" / "0"})
-    if (fs::is_regular_file(candidate / "cameras.txt") && fs::is_regular_file(candidate / "images.txt"))
-      return candidate;
-  return std::nullopt;
-}
-
 std::vector<fs::path> files_with_suffix(const fs::path& folder, const std::string& suffix) {
   std::vector<fs::path> found;
   for (const auto& entry : fs::directory_iterator(folder))
@@ -96,11 +89,13 @@ SceneLocation locate_scene(const fs::path& path) {
     const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
     if (has_suffix(name, "_par.txt")) return {folder, path, CameraFormat::Middlebury};
     if (has_suffix(name, "_pm.txt")) return {folder, path, CameraFormat::PhotoModeler};
+    // A named COLMAP file picks its model even where the folder holds both.
     if (name == "cameras.txt" || name == "images.txt") return {folder, folder, CameraFormat::Colmap};
+    if (name == "cameras.bin" || name == "images.bin") return {folder, folder, CameraFormat::ColmapBinary};
     throw InputError(path, 0,
-                     "not a camera file (expected *_par.txt, *_pm.txt, or COLMAP cameras.txt/images.txt)");
+                     "not a camera file (expected *_par.txt, *_pm.txt, or COLMAP cameras/images .txt or .bin)");
   }
-  if (auto colmap = colmap_folder(path)) return {path, *colmap, CameraFormat::Colmap};
+  if (auto colmap = find_colmap_model(path)) return {path, colmap->folder, colmap->format};
   const auto middlebury = files_with_suffix(path, "_par.txt");
   const auto photomodeler = files_with_suffix(path, "_pm.txt");
   if (middlebury.size() + photomodeler.size() > 1)
@@ -110,8 +105,8 @@ SceneLocation locate_scene(const fs::path& path) {
   if (middlebury.size() == 1) return {path, middlebury.front(), CameraFormat::Middlebury};
   if (photomodeler.size() == 1) return {path, photomodeler.front(), CameraFormat::PhotoModeler};
   throw InputError(path, 0,
-                   "no cameras found (expected COLMAP cameras.txt + images.txt here or in sparse/ or "
-                   "sparse/0/, a Middlebury *_par.txt, or a PhotoModeler-style *_pm.txt)");
+                   "no cameras found (expected COLMAP cameras.bin + images.bin or cameras.txt + images.txt "
+                   "here or in sparse/ or sparse/0/, a Middlebury *_par.txt, or a PhotoModeler-style *_pm.txt)");
 }
 
 std::optional<fs::path> find_image(const fs::path& camera_folder, const std::string& image_name) {
@@ -174,8 +169,7 @@ Scene load_scene(const fs::path& path, const SceneLoadOptions& options) {
   scene.camera_format = camera_format_name(location.format);
   scene.views = read_cameras(location.camera_path, location.format);
   if (scene.views.empty()) throw InputError(location.camera_path, 0, "the camera file holds no camera");
-  const fs::path camera_folder =
-      location.format == CameraFormat::Colmap ? location.folder : location.camera_path.parent_path();
+  const fs::path camera_folder = is_colmap(location.format) ? location.folder : location.camera_path.parent_path();
   attach_image_sizes(scene, camera_folder.empty() ? fs::path(".") : camera_folder);
 
   std::vector<fs::path> image_files;

@@ -1,6 +1,8 @@
 #pragma once
 // Scene folders. A SCENE argument is a folder, or a camera file inside one:
-// - COLMAP: cameras.txt + images.txt in the folder, in sparse/ or in sparse/0/;
+// - COLMAP: cameras.bin + images.bin or cameras.txt + images.txt in the folder, in sparse/ or in
+//   sparse/0/ (the first of these holding a model; binary before text in one folder, see
+//   find_colmap_model; naming cameras.txt or cameras.bin picks that model);
 // - Middlebury: one `*_par.txt`;
 // - PhotoModeler-style: one `*_pm.txt` (README "Formats").
 // Images are looked up beside the camera file, then in an `images/` folder beside it.
@@ -18,7 +20,7 @@ namespace mvflow::io {
 
 struct SceneLocation {
   std::filesystem::path folder;
-  std::filesystem::path camera_path;  //!< the camera file (COLMAP: the folder holding the two files)
+  std::filesystem::path camera_path;  //!< the camera file (COLMAP: the folder holding the model's files)
   CameraFormat format = CameraFormat::Middlebury;
 };
 

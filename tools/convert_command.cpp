@@ -35,6 +35,7 @@ io::CameraFormat output_camera_format(const ConvertArguments& args) {
   const std::string name = fs::path(args.output).filename().string();
   if (name.ends_with("_par.txt")) return io::CameraFormat::Middlebury;
   if (name.ends_with("_pm.txt")) return io::CameraFormat::PhotoModeler;
+  if (name == "cameras.bin") return io::CameraFormat::ColmapBinary;
   return io::CameraFormat::Colmap;  // a folder (or cameras.txt) receives cameras.txt + images.txt
 }
 
@@ -51,8 +52,8 @@ int convert_cameras(const ConvertArguments& args, spdlog::logger& log) {
   const io::SceneLocation location = io::locate_scene(args.input);
   std::vector<View> views = io::read_cameras(location.camera_path, location.format);
   // Formats without image sizes (Middlebury) take them from the images, if present.
-  const fs::path camera_folder = location.format == io::CameraFormat::Colmap ? location.folder
-                                                                             : location.camera_path.parent_path();
+  const fs::path camera_folder =
+      io::is_colmap(location.format) ? location.folder : location.camera_path.parent_path();
   for (std::size_t i = 0; i < views.size(); ++i) {
     if (views[i].camera.width() > 0) continue;
     const auto image = io::find_image(camera_folder, views[i].image_name);
@@ -65,10 +66,18 @@ int convert_cameras(const ConvertArguments& args, spdlog::logger& log) {
   }
   const io::CameraFormat format = output_camera_format(args);
   fs::path output = args.output;
-  if (format == io::CameraFormat::Colmap && output.filename() == "cameras.txt") output = output.parent_path();
-  if (format == io::CameraFormat::Colmap && !output.empty()) fs::create_directories(output);
+  if (io::is_colmap(format) && (output.filename() == "cameras.txt" || output.filename() == "cameras.bin"))
+    output = output.parent_path();
+  if (io::is_colmap(format) && !output.empty()) fs::create_directories(output);
   io::write_cameras(output, views, format);
   log.info("wrote {} cameras to {} ({})", views.size(), output.string(), io::camera_format_name(format));
+  // A binary model already in the folder would be read instead of the text one just written.
+  if (io::is_colmap(format)) {
+    const auto found = io::find_colmap_model(output.empty() ? fs::path(".") : output);
+    if (found && found->format != format)
+      log.warn("{} also holds a COLMAP {} model, which is read instead of the one just written",
+               found->folder.string(), io::camera_format_name(found->format));
+  }
   return kOk;
 }
 
@@ -77,13 +86,18 @@ int convert_cameras(const ConvertArguments& args, spdlog::logger& log) {
 void add_convert_command(CLI::App& app, Runner& runner) {
   auto args = std::make_shared<ConvertArguments>();
   CLI::App* command = app.add_subcommand(
-      "convert", "Convert a mesh (.ply .obj .off .stl .wrl) or a scene's cameras (Middlebury, COLMAP, PhotoModeler-style)");
+      "convert", "Convert a mesh (.ply .obj .off .stl .wrl) or a scene's cameras (Middlebury, COLMAP text or binary, "
+      "PhotoModeler-style)");
   command->add_option("input", args->input, "Mesh file, or scene folder / camera file")->required();
   command->add_option("output", args->output,
-                      "Mesh file (format from the extension), or camera output: *_par.txt, *_pm.txt, or a folder for COLMAP")
+                      "Mesh file (format from the extension), or camera output: *_par.txt, *_pm.txt, or a folder "
+                      "for COLMAP (text; binary with --to colmap-bin or OUT = .../cameras.bin)")
       ->required();
-  command->add_option("--to", args->to, "Camera output format: middlebury, colmap, photomodeler (default: from OUT)")
-      ->check(CLI::IsMember({"middlebury", "colmap", "photomodeler"}));
+  command
+      ->add_option("--to", args->to,
+                   "Camera output format: middlebury, colmap (text), colmap-bin (binary), photomodeler "
+                   "(default: from OUT)")
+      ->check(CLI::IsMember({"middlebury", "colmap", "colmap-bin", "photomodeler"}));
   command->add_flag("--ascii", args->ascii, "Write PLY/STL as ASCII instead of binary");
   command->callback([args, &runner] {
     runner = [args](spdlog::logger& log) {
