@@ -58,7 +58,6 @@ class SurfaceQuery {
   //! The nearest surface point to \p point (exact point–triangle distance in double).
   ClosestPoint closest_point(const Eigen::Vector3d& point) const;
 
-  std::size_t n_triangles() const { return triangles_.size(); }
 
  private:
   struct Embree;

@@ -1,7 +1,6 @@
 #include "stages/heldout_error.h"
 
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -16,7 +15,7 @@ namespace mvflow {
 
 bool HeldoutOptions::check() const {
   return supersample >= 1 && supersample <= 8 && background.allFinite() && background.minCoeff() >= 0.0f &&
-         background.maxCoeff() <= 1.0f && colouring.check() && threads >= 0;
+         background.maxCoeff() <= 1.0f && colouring.check();
 }
 
 double HeldoutMetrics::mae() const {
@@ -206,8 +205,7 @@ HeldoutRendering HeldoutRenderer::render(int view) const {
                         r.unseen[index] || valued == 0 ? options_.background : Eigen::Vector3f(sum / valued));
     }
   };
-  tbb::task_arena arena(options_.threads > 0 ? options_.threads : tbb::task_arena::automatic);
-  arena.execute([&] { tbb::parallel_for(0, h, render_row); });
+  tbb::parallel_for(0, h, render_row);  // in the caller's arena: the result does not depend on it
   return r;
 }
 

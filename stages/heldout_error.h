@@ -34,8 +34,6 @@ struct HeldoutOptions {
   Eigen::Vector3f background{0.0f, 0.0f, 0.0f};
   //! Which views colour a surface point (grazing angle, occlusion-ray offset).
   PointColouringOptions colouring;
-  //! Threads to render with; 0 = TBB's default. The result does not depend on it.
-  int threads = 0;
   bool check() const;
 };
 

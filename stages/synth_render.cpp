@@ -2,7 +2,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -49,7 +48,6 @@ void RenderOptions::check() const {
   if (!(specular >= 0 && specular <= 1)) throw InputError("render: the specular weight must be in [0, 1]");
   if (!(shininess >= 1 && shininess <= 10000)) throw InputError("render: the specular exponent must be in [1, 10000]");
   if (!(noise >= 0 && noise <= 1)) throw InputError("render: the noise sigma must be in [0, 1]");
-  if (threads < 0) throw InputError("render: the thread count must be >= 0");
 }
 
 std::vector<Eigen::Vector3d> vertex_normals(const IndexedMesh& mesh) {
@@ -155,17 +153,10 @@ void SynthRenderer::render_rows(const Camera& camera, std::size_t view_index, in
 Image SynthRenderer::render(const Camera& camera, std::size_t view_index) const {
   MVFLOW_CHECK(camera.width() > 0 && camera.height() > 0, "render: the camera has no image size");
   Image image(camera.width(), camera.height());
-  auto body = [&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, image.height()), [&](const tbb::blocked_range<int>& rows) {
-      render_rows(camera, view_index, rows.begin(), rows.end(), image);
-    });
-  };
-  if (options_.threads > 0) {
-    tbb::task_arena arena(options_.threads);
-    arena.execute(body);
-  } else {
-    body();
-  }
+  // In the caller's arena (its thread count); the image does not depend on it.
+  tbb::parallel_for(tbb::blocked_range<int>(0, image.height()), [&](const tbb::blocked_range<int>& rows) {
+    render_rows(camera, view_index, rows.begin(), rows.end(), image);
+  });
   return image;
 }
 

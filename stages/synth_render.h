@@ -33,7 +33,6 @@ struct RenderOptions {
   double noise = 0.0;        //!< σ of Gaussian noise added to every channel, on [0,1] values (0..1)
   std::uint64_t seed = 1;    //!< seeds the noise; per view and row, so threads do not matter
   BackgroundKind background = BackgroundKind::Textured;
-  int threads = 0;           //!< threads to render with; 0 = TBB's default
   //! \throw InputError naming the field when a value is out of range.
   void check() const;
 };

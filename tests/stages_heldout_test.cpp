@@ -9,6 +9,8 @@
 #include <numbers>
 #include <random>
 
+#include <tbb/task_arena.h>
+
 #include "engine/error.h"
 #include "engine/primitives.h"
 #include "stages/heldout_error.h"
@@ -171,11 +173,13 @@ TEST(Heldout, ColouringNeverReadsAHeldOutPhotograph) {
 
 TEST(Heldout, SameImageWhateverTheThreadCount) {
   const Scene scene = make_scene(small_scene().images);
-  HeldoutOptions one, two;
-  one.threads = 1;
-  two.threads = 2;
-  const HeldoutRendering a = HeldoutRenderer(scene, small_scene().initial, {4}, one).render(4);
-  const HeldoutRendering b = HeldoutRenderer(scene, small_scene().initial, {4}, two).render(4);
+  // The caller chooses the threads (an arena); the stage only splits its rows.
+  auto render_with = [&](int threads) {
+    tbb::task_arena arena(threads);
+    return arena.execute([&] { return HeldoutRenderer(scene, small_scene().initial, {4}).render(4); });
+  };
+  const HeldoutRendering a = render_with(1);
+  const HeldoutRendering b = render_with(2);
   EXPECT_TRUE(same_pixels(a.image, b.image));
   EXPECT_EQ(a.silhouette.inside, b.silhouette.inside);
   EXPECT_EQ(a.unseen, b.unseen);

@@ -9,6 +9,8 @@
 #include <filesystem>
 
 #include "engine/error.h"
+#include <tbb/task_arena.h>
+
 #include "io/atomic_write.h"
 #include "io/image_io.h"
 #include "io/mask_files.h"
@@ -35,6 +37,7 @@ struct HeldoutArguments {
   double error_scale = 0.25;
   SilhouetteOptions silhouette;
   HeldoutOptions options;
+  int threads = 0;
 };
 
 // +inf and NaN have no JSON number: null stands for them (PSNR of identical images, no scored pixel).
@@ -64,7 +67,7 @@ nlohmann::json options_json(const HeldoutArguments& args, const HeldoutOptions& 
           {"ray_offset", o.colouring.ray_offset},
           {"real_silhouette", silhouette},
           {"error_scale", args.error_scale},
-          {"threads", o.threads}};
+          {"threads", args.threads}};
 }
 
 std::string format_psnr(double psnr) {
@@ -207,14 +210,17 @@ void add_heldout_command(CLI::App& app, Runner& runner) {
                 "Error map: this mean absolute error shows as full yellow")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  c->add_option("--threads", args->options.threads,
+  c->add_option("--threads", args->threads,
                 "Threads (0 = all cores); the result does not depend on it")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   c->callback([args, &runner] {
     if (args->background.size() == 2)
       throw CLI::ValidationError("--background", "give one grey value or R,G,B");
-    runner = [args](spdlog::logger& log) { return run_heldout(*args, log); };
+    runner = [args](spdlog::logger& log) {
+      tbb::task_arena arena(args->threads > 0 ? args->threads : tbb::task_arena::automatic);
+      return arena.execute([&] { return run_heldout(*args, log); });
+    };
   });
 }
 

@@ -11,6 +11,8 @@
 #include <sstream>
 
 #include "engine/error.h"
+#include <tbb/task_arena.h>
+
 #include "io/atomic_write.h"
 #include "io/camera_io.h"
 #include "io/image_io.h"
@@ -203,7 +205,6 @@ SynthOptions to_options(const Settings& s) {
   o.render.noise = s.noise;
   o.render.supersample = s.supersample;
   o.render.background = s.background == "black" ? BackgroundKind::Black : BackgroundKind::Textured;
-  o.render.threads = s.threads;
   o.rig.kind = s.rig == "hemisphere" ? RigKind::Hemisphere : RigKind::Ring;
   o.rig.views = s.views;
   o.rig.distance = s.distance;
@@ -360,7 +361,8 @@ int run_synth(SynthArguments& args, spdlog::logger& log) {
   const auto start = std::chrono::steady_clock::now();
   SynthScene scene;
   try {
-    scene = make_synth_scene(object.mesh, object.texture, options);
+    tbb::task_arena arena(s.threads > 0 ? s.threads : tbb::task_arena::automatic);
+    arena.execute([&] { scene = make_synth_scene(object.mesh, object.texture, options); });
   } catch (const InputError& e) {
     if (object.mesh_file.empty()) throw;
     throw InputError(object.mesh_file, 0, e.what());  // e.g. an open mesh: name the file
