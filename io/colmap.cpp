@@ -123,11 +123,7 @@ std::vector<View> read_images_txt(const fs::path& file, const std::map<long long
           "expected the POINTS2D line (X Y POINT3D_ID triples, possibly empty) after the image line, got " +
           std::to_string(split_whitespace(reader.line()).size()) + " fields");
   }
-  std::sort(images.begin(), images.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<View> views;
-  views.reserve(images.size());
-  for (auto& image : images) views.push_back(std::move(image.second));
-  return views;
+  return colmap::views_by_image_id(std::move(images));
 }
 
 void check_name(const fs::path& file, std::size_t index, const std::string& name) {

@@ -91,7 +91,7 @@ std::vector<View> read_images_bin(const fs::path& file, const std::map<std::uint
   BinaryReader in(file);
   const auto count = in.read<std::uint64_t>("the number of images");
   in.check_count(count, kMinImageBytes, 0, "the number of images");
-  std::vector<std::pair<std::uint32_t, View>> images;
+  std::vector<std::pair<long long, View>> images;
   std::map<std::uint32_t, std::uint64_t> defined_at;
   for (std::uint64_t i = 0; i < count; ++i) {
     const std::string image = ordinal("image", i, count);
@@ -132,11 +132,7 @@ std::vector<View> read_images_bin(const fs::path& file, const std::map<std::uint
     }
   }
   in.expect_end("the " + std::to_string(count) + " images");
-  std::sort(images.begin(), images.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<View> views;
-  views.reserve(images.size());
-  for (auto& image : images) views.push_back(std::move(image.second));
-  return views;
+  return colmap::views_by_image_id(std::move(images));
 }
 
 void check_name(const fs::path& file, std::size_t index, const std::string& name) {

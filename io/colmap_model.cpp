@@ -150,6 +150,14 @@ Eigen::Vector4d quaternion_of(const Camera& camera) {
   return {q.w(), q.x(), q.y(), q.z()};
 }
 
+std::vector<View> views_by_image_id(std::vector<std::pair<long long, View>> images) {
+  std::sort(images.begin(), images.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<View> views;
+  views.reserve(images.size());
+  for (auto& image : images) views.push_back(std::move(image.second));
+  return views;
+}
+
 }  // namespace colmap
 
 std::optional<ColmapModel> find_colmap_model(const std::filesystem::path& folder) {

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "engine/camera.h"
@@ -77,5 +78,8 @@ Model choose_model(const std::filesystem::path& file, std::size_t index, const C
 std::vector<double> model_parameters(Model model, const Camera& camera);
 //! (QW, QX, QY, QZ) of camera.R(), with QW ≥ 0: one sign for reproducible files.
 Eigen::Vector4d quaternion_of(const Camera& camera);
+
+//! The views of (IMAGE_ID, view) pairs in IMAGE_ID order, COLMAP's order for both file kinds.
+std::vector<View> views_by_image_id(std::vector<std::pair<long long, View>> images);
 
 }  // namespace mvflow::io::colmap

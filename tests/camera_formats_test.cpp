@@ -18,6 +18,7 @@
 #include "engine/camera.h"
 #include "engine/error.h"
 #include "io/camera_io.h"
+#include "colmap_reference.h"
 
 namespace {
 
@@ -327,28 +328,6 @@ struct ColmapCase {
   std::vector<double> params;
 };
 
-// COLMAP's ImgFromCam for the five models, from COLMAP's definitions (models.h), in COLMAP pixels.
-Eigen::Vector2d colmap_image_from_camera(const ColmapCase& c, double u, double v) {
-  const auto& p = c.params;
-  const double r2 = u * u + v * v;
-  if (c.model == "SIMPLE_PINHOLE") return {p[0] * u + p[1], p[0] * v + p[2]};
-  if (c.model == "PINHOLE") return {p[0] * u + p[2], p[1] * v + p[3]};
-  if (c.model == "SIMPLE_RADIAL") {
-    const double radial = p[3] * r2;
-    return {p[0] * (u + u * radial) + p[1], p[0] * (v + v * radial) + p[2]};
-  }
-  if (c.model == "RADIAL") {
-    const double radial = p[3] * r2 + p[4] * r2 * r2;
-    return {p[0] * (u + u * radial) + p[1], p[0] * (v + v * radial) + p[2]};
-  }
-  // OPENCV
-  const double k1 = p[4], k2 = p[5], p1 = p[6], p2 = p[7];
-  const double radial = k1 * r2 + k2 * r2 * r2;
-  const double du = u * radial + 2 * p1 * u * v + p2 * (r2 + 2 * u * u);
-  const double dv = v * radial + 2 * p2 * u * v + p1 * (r2 + 2 * v * v);
-  return {p[0] * (u + du) + p[2], p[1] * (v + dv) + p[3]};
-}
-
 const std::vector<ColmapCase>& colmap_cases() {
   static const std::vector<ColmapCase> cases{
       {"SIMPLE_PINHOLE", {1100.5, 320.25, 240.75}},
@@ -420,7 +399,8 @@ TEST_F(CameraFormats, ColmapProjectionMatchesColmapModels) {
     const Eigen::Matrix3d R = quaternion_matrix(q[0], q[1], q[2], q[3]);
     for (const auto& X : test_points()) {
       const Eigen::Vector3d x = R * X + images[i].t;
-      const Eigen::Vector2d colmap_pixel = colmap_image_from_camera(cases[i], x(0) / x(2), x(1) / x(2));
+      const Eigen::Vector2d colmap_pixel =
+          mvflow::test::colmap_image_from_camera(cases[i].model, cases[i].params, x(0) / x(2), x(1) / x(2));
       const auto p = views[i].camera.project(X);
       // COLMAP's top-left pixel centre is (0.5, 0.5), mvflow's (0, 0).
       EXPECT_NEAR(p.u, colmap_pixel.x() - 0.5, 1e-9 * std::abs(p.u));

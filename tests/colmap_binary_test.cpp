@@ -22,6 +22,7 @@
 #include "engine/error.h"
 #include "io/camera_io.h"
 #include "io/scene_io.h"
+#include "colmap_reference.h"
 #include "test_support.h"
 
 namespace mvflow {
@@ -196,27 +197,6 @@ void write_binary_model(const fs::path& folder, const std::vector<ModelCamera>& 
   test::write_text(folder / "points3D.bin", Encoder().u64(0).bytes);
 }
 
-// COLMAP's ImgFromCam (sensor/models.h) for the five models, in COLMAP pixels.
-Eigen::Vector2d colmap_image_from_camera(const ModelCamera& c, double u, double v) {
-  const auto& p = c.params;
-  const double r2 = u * u + v * v;
-  if (c.model == "SIMPLE_PINHOLE") return {p[0] * u + p[1], p[0] * v + p[2]};
-  if (c.model == "PINHOLE") return {p[0] * u + p[2], p[1] * v + p[3]};
-  if (c.model == "SIMPLE_RADIAL") {
-    const double radial = p[3] * r2;
-    return {p[0] * (u + u * radial) + p[1], p[0] * (v + v * radial) + p[2]};
-  }
-  if (c.model == "RADIAL") {
-    const double radial = p[3] * r2 + p[4] * r2 * r2;
-    return {p[0] * (u + u * radial) + p[1], p[0] * (v + v * radial) + p[2]};
-  }
-  const double k1 = p[4], k2 = p[5], p1 = p[6], p2 = p[7];  // OPENCV
-  const double radial = k1 * r2 + k2 * r2 * r2;
-  const double du = u * radial + 2 * p1 * u * v + p2 * (r2 + 2 * u * u);
-  const double dv = v * radial + 2 * p2 * u * v + p1 * (r2 + 2 * v * v);
-  return {p[0] * (u + du) + p[2], p[1] * (v + dv) + p[3]};
-}
-
 // Bit-for-bit equality of everything a view holds.
 void expect_identical(const View& expected, const View& actual) {
   EXPECT_EQ(expected.image_name, actual.image_name);
@@ -282,7 +262,8 @@ TEST(ColmapBinary, ColmapLayoutDecodesToTheCamerasOfTheTextModel) {
     for (const Eigen::Vector3d& X : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.3, -0.2, 0.1),
                                      Eigen::Vector3d(-0.4, 0.25, -0.2), Eigen::Vector3d(0.1, 0.45, 0.3)}) {
       const Eigen::Vector3d x = R * X + t;
-      const Eigen::Vector2d colmap_pixel = colmap_image_from_camera(camera, x(0) / x(2), x(1) / x(2));
+      const Eigen::Vector2d colmap_pixel =
+          test::colmap_image_from_camera(camera.model, camera.params, x(0) / x(2), x(1) / x(2));
       const Projection p = view.camera.project(X);
       EXPECT_NEAR(p.u, colmap_pixel.x() - 0.5, 1e-9 * std::abs(colmap_pixel.x()));
       EXPECT_NEAR(p.v, colmap_pixel.y() - 0.5, 1e-9 * std::abs(colmap_pixel.y()));
