@@ -1,5 +1,7 @@
 #include "engine/mesh.h"
 
+#include <mutex>
+
 #include <OpenMesh/Core/System/omstream.hh>
 #include <cmath>
 
@@ -102,17 +104,39 @@ std::vector<std::array<std::uint32_t, 3>> triangles_of(const TriMesh& mesh) {
   return triangles;
 }
 
-QuietOpenMesh::QuietOpenMesh()
-    : err_(omerr().is_enabled()), log_(omlog().is_enabled()), out_(omout().is_enabled()) {
+namespace {
+
+// The streams' state before the first live QuietOpenMesh, and how many live now.
+struct QuietState {
+  std::mutex mutex;
+  int live = 0;
+  bool err = false, log = false, out = false;
+};
+
+QuietState& quiet_state() {
+  static QuietState state;
+  return state;
+}
+
+}  // namespace
+
+QuietOpenMesh::QuietOpenMesh() {
+  QuietState& s = quiet_state();
+  const std::lock_guard lock(s.mutex);
+  if (s.live++ > 0) return;
+  s.err = omerr().is_enabled(), s.log = omlog().is_enabled(), s.out = omout().is_enabled();
   omerr().disable();
   omlog().disable();
   omout().disable();
 }
 
 QuietOpenMesh::~QuietOpenMesh() {
-  if (err_) omerr().enable();
-  if (log_) omlog().enable();
-  if (out_) omout().enable();
+  QuietState& s = quiet_state();
+  const std::lock_guard lock(s.mutex);
+  if (--s.live > 0) return;
+  if (s.err) omerr().enable();
+  if (s.log) omlog().enable();
+  if (s.out) omout().enable();
 }
 
 }  // namespace mvflow

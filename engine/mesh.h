@@ -72,17 +72,17 @@ std::vector<Eigen::Vector3d> positions_of(const TriMesh& mesh);
 //! Triangles of \p mesh, #F, in face-id order, corners in OpenMesh's face-vertex order.
 std::vector<std::array<std::uint32_t, 3>> triangles_of(const TriMesh& mesh);
 
-//! Keeps OpenMesh's console messages (omerr, omlog, omout) quiet while it lives: mvflow reports
-//! problems itself, with the file and element named. Not thread-safe (OpenMesh's streams are global).
+//! Keeps OpenMesh's console messages (omerr, omlog, omout) quiet while any instance lives: mvflow
+//! reports problems itself, with the file and element named. OpenMesh's streams are process-wide,
+//! so the instances share one count under a lock: the first switches the streams off (noting how
+//! the host had them), the last one gone restores them, in whatever order and from whatever
+//! threads they end (a host's own OpenMesh logging is never left off, never raced).
 class QuietOpenMesh {
  public:
   QuietOpenMesh();
   ~QuietOpenMesh();
   QuietOpenMesh(const QuietOpenMesh&) = delete;
   QuietOpenMesh& operator=(const QuietOpenMesh&) = delete;
-
- private:
-  bool err_, log_, out_;
 };
 
 }  // namespace mvflow

@@ -3,6 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <OpenMesh/Core/System/omstream.hh>
+#include <memory>
+#include <thread>
+#include <vector>
+
 #include "engine/error.h"
 #include "engine/mesh_stats.h"
 #include "engine/vertex_fields.h"
@@ -114,6 +119,35 @@ TEST(BuildMesh, KeepsTexcoordsWithTheirCorners) {
   const IndexedMesh back = to_indexed(mesh);
   for (std::size_t f = 0; f < back.triangles.size(); ++f)
     for (int c = 0; c < 3; ++c) EXPECT_EQ(back.texcoords[3 * f + c].x(), static_cast<float>(back.triangles[f][c]));
+}
+
+TEST(QuietOpenMesh, StreamsStayOffWhileAnyLivesAndComeBackAsTheHostHadThem) {
+  // The host logs through OpenMesh's omlog but keeps omout off.
+  omlog().enable();
+  omout().disable();
+  // Out of order, as two threads' instances can end: the first made is not the last gone.
+  auto first = std::make_unique<QuietOpenMesh>();
+  auto second = std::make_unique<QuietOpenMesh>();
+  EXPECT_FALSE(omlog().is_enabled());
+  first.reset();
+  EXPECT_FALSE(omlog().is_enabled()) << "on again while an instance still lives";
+  EXPECT_FALSE(omerr().is_enabled());
+  second.reset();
+  EXPECT_TRUE(omlog().is_enabled()) << "the host's stream left off";
+  EXPECT_FALSE(omout().is_enabled()) << "a stream the host had off turned on";
+  // Many threads at once (mesh reads in parallel jobs): the host's state comes back.
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 8; ++t)
+    threads.emplace_back([] {
+      for (int i = 0; i < 2000; ++i) {
+        const QuietOpenMesh quiet;
+        EXPECT_FALSE(omlog().is_enabled());
+      }
+    });
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_TRUE(omlog().is_enabled());
+  EXPECT_FALSE(omout().is_enabled());
+  omout().enable();
 }
 
 TEST(AtomicWrite, ExceptionLeavesDestinationAndNoTemporary) {
