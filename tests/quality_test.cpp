@@ -59,6 +59,10 @@ void expect_refinement_halves_the_error(const std::string& name, const std::stri
   EXPECT_LE(after.accuracy, 0.5 * before.accuracy);
   EXPECT_LT(g_after, g_before);
   EXPECT_EQ(r.at("final").at("self_intersecting_face_pairs").get<int>(), 0);
+  // It ended by a stopping rule, well inside the iteration budget (issue 12: convergence).
+  const std::string status = r.at("status").get<std::string>();
+  EXPECT_TRUE(status == "converged" || status == "step-small") << status;
+  EXPECT_LE(r.at("iterations").size(), 0.75 * r.at("options").at("max_iterations").get<double>());
 
   const test::CommandResult info = test::run_mvflow("info " + scene.string() + " --mesh " + refined.string());
   ASSERT_EQ(info.exit_code, 0) << info.output;
