@@ -36,6 +36,20 @@ class StageTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
+// Every per-block kernel: nothing once the run is cancelled (the rest of a cancelled graph
+// drains at once), \p body timed into \p seconds (null: untimed), then on_block.
+template <class Body>
+void run_block(IterationData& data, std::size_t block, double* seconds, Body&& body) {
+  if (data.cancelled()) return;
+  if (seconds) {
+    StageTimer timer(*seconds);
+    body();
+  } else {
+    body();
+  }
+  if (data.on_block) data.on_block(block);
+}
+
 }  // namespace
 
 IterationData::IterationData(TriMesh& mesh_, const std::vector<PhotoView>& views_, const RefineOptions& options_,
@@ -82,36 +96,36 @@ void IterationData::refit() {
 }
 
 void IterationData::geometry(std::size_t block) {
-  if (cancelled()) return;
-  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Geometry)]);
-  compute_normals(mesh, blocks[block], fields);
-  compute_mean_curvature(mesh, blocks[block], fields, options.curvature);
-  compute_local_edges(mesh, blocks[block], fields);
+  run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Geometry)], [&] {
+    compute_normals(mesh, blocks[block], fields);
+    compute_mean_curvature(mesh, blocks[block], fields, options.curvature);
+    compute_local_edges(mesh, blocks[block], fields);
+  });
 }
 
 void IterationData::visibility(std::size_t block) {
-  if (cancelled()) return;
-  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Visibility)]);
-  compute_visibility(mesh, blocks[block], views, *surface, mean_edge, options.visibility, fields);
-  drop_outlier_views(mesh, blocks[block], views, options.photo.photo, fields);
+  run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Visibility)], [&] {
+    compute_visibility(mesh, blocks[block], views, *surface, mean_edge, options.visibility, fields);
+    drop_outlier_views(mesh, blocks[block], views, options.photo.photo, fields);
+  });
 }
 
 void IterationData::photo_speed(std::size_t block) {
-  if (cancelled()) return;
-  StageTimer timer(block_seconds[block][static_cast<int>(Stage::PhotoGradient)]);
-  if (options.engine == EngineKind::Graph) {
-    // Idle threads take parts of a long photo node (nested parallelism: the graph is the coarse
-    // level). Every vertex is independent, so the parts do not change any result.
-    const IndexRange range = blocks[block];
-    oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::uint32_t>(range.begin, range.end, kPhotoGrain),
-                              [&](const oneapi::tbb::blocked_range<std::uint32_t>& part) {
-                                photo.run(mesh, {part.begin(), part.end()}, views, sample_spacing, fields);
-                              });
-  } else {
-    photo.run(mesh, blocks[block], views, sample_spacing, fields);
-  }
-  compute_speed(blocks[block], options.speed, fields);
-  partials[block] = reduce_block(blocks[block], fields);
+  run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::PhotoGradient)], [&] {
+    if (options.engine == EngineKind::Graph) {
+      // Idle threads take parts of a long photo node (nested parallelism: the graph is the coarse
+      // level). Every vertex is independent, so the parts do not change any result.
+      const IndexRange range = blocks[block];
+      oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::uint32_t>(range.begin, range.end, kPhotoGrain),
+                                [&](const oneapi::tbb::blocked_range<std::uint32_t>& part) {
+                                  photo.run(mesh, {part.begin(), part.end()}, views, sample_spacing, fields);
+                                });
+    } else {
+      photo.run(mesh, blocks[block], views, sample_spacing, fields);
+    }
+    compute_speed(blocks[block], options.speed, fields);
+    partials[block] = reduce_block(blocks[block], fields);
+  });
 }
 
 void IterationData::cfl() {
@@ -180,33 +194,29 @@ void IterationData::adapt_step_scale() {
 }
 
 void IterationData::move(std::size_t block) {
-  if (cancelled()) return;
-  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Move)]);
-  move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside, &moved);
+  run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Move)],
+            [&] { move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside, &moved); });
 }
 
 void IterationData::smooth(std::size_t block) {
-  if (cancelled()) return;
-  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Smoothing)]);
-  smooth_curvature_normal(mesh, blocks[block], options.smoothing, new_positions);
+  run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Smoothing)],
+            [&] { smooth_curvature_normal(mesh, blocks[block], options.smoothing, new_positions); });
 }
 
 void IterationData::inflate(std::size_t block) {
-  if (cancelled()) return;
-  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Smoothing)]);
-  inflate_curvature_normal(mesh, blocks[block], options.smoothing, new_positions);
+  run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Smoothing)],
+            [&] { inflate_curvature_normal(mesh, blocks[block], options.smoothing, new_positions); });
 }
 
 void IterationData::regularize(std::size_t block) {
-  if (cancelled()) return;
-  StageTimer timer(block_seconds[block][static_cast<int>(Stage::Regularization)]);
-  compute_normals(mesh, blocks[block], fields);  // at the smoothed positions
-  regularize_tangential(mesh, blocks[block], fields, options.regularization, new_positions);
+  run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Regularization)], [&] {
+    compute_normals(mesh, blocks[block], fields);  // at the smoothed positions
+    regularize_tangential(mesh, blocks[block], fields, options.regularization, new_positions);
+  });
 }
 
 void IterationData::commit(std::size_t block) {
-  if (cancelled()) return;
-  commit_positions(mesh, blocks[block], new_positions, inside);
+  run_block(*this, block, nullptr, [&] { commit_positions(mesh, blocks[block], new_positions, inside); });
 }
 
 void run_iteration_sequential(IterationData& data) {

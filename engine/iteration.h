@@ -7,6 +7,7 @@
 #include <array>
 #include <atomic>
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -35,6 +36,8 @@ struct IterationData {
   const std::vector<PhotoView>& views;
   const RefineOptions& options;
   const std::atomic<bool>* cancel;
+  //! Called after each per-block kernel did its work (RefineControl::on_block); may be empty.
+  std::function<void(std::size_t block)> on_block;
   PhotoGradientStage photo;
   const SilhouetteConstraint* inside = nullptr;  //!< keeps the surface in the visual hull when set
 
@@ -69,7 +72,15 @@ struct IterationData {
 
   //! Sizes everything for the mesh's current topology (new blocks, fields, Embree scene).
   void reset_topology();
-  bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
+  //! True once the cancel flag has been seen, even if the host clears it again: an iteration
+  //! whose kernels skipped blocks never counts as done (see stopped).
+  bool cancelled() {
+    if (stopped.load(std::memory_order_relaxed)) return true;
+    if (!cancel || !cancel->load(std::memory_order_relaxed)) return false;
+    stopped.store(true, std::memory_order_relaxed);
+    return true;
+  }
+  std::atomic<bool> stopped{false};  //!< a kernel saw the cancel flag (set by cancelled())
 
   // The kernels. `block` indexes `blocks`.
   void set_edge_lengths(const EdgeLengths& edges);  //!< e_min, the mean edge and Δx, before an iteration

@@ -29,10 +29,11 @@ class IterationGraph {
   IterationGraph& operator=(const IterationGraph&) = delete;
 
   //! Runs one iteration and waits for it. Rethrows the first exception a node threw (after
-  //! cancelling the rest); the graph is reset and can run again either way.
+  //! cancelling the rest); the graph is reset and can run again either way. Once the cancel flag
+  //! is set the rest of the graph drains: every kernel checks the flag and returns at once (the
+  //! whole graph with empty bodies takes 0.06 ms at 10k vertices, perf/README.md), so the flag
+  //! needs no cancellation of the graph's task_group_context.
   void run();
-  //! Stops the nodes that have not started (the kernels also check the cancel flag).
-  void cancel() { graph_.cancel(); }
   std::size_t n_blocks() const { return n_blocks_; }
 
  private:

@@ -117,6 +117,7 @@ class Refinement {
   Refinement(const Scene& scene, const Mesh& initial, const RefineOptions& options, const RefineControl& control)
       : options_(options), control_(control), full_views_(usable_views(scene, options.excluded_views)),
         views_(full_views_), mesh_(initial.topology), data_(mesh_, views_, options_, control.cancel) {
+    data_.on_block = control.on_block;
     for (int level = 0; level < options.image_levels; ++level)
       levels_.push_back(half_resolution(level == 0 ? full_views_ : levels_.back()->views));
     if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
@@ -165,7 +166,7 @@ class Refinement {
       } else {
         run_iteration_sequential(data_);
       }
-      if (cancelled()) {
+      if (cancelled() || data_.stopped) {  // its kernels skipped blocks: the iteration did not happen
         status = RefineStatus::Cancelled;
         break;
       }

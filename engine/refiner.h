@@ -31,6 +31,9 @@ struct RefineControl {
   std::shared_ptr<spdlog::logger> logger;              //!< null: no log lines
   const std::atomic<bool>* cancel = nullptr;           //!< set to stop at the next block
   std::function<void(const IterationReport&)> on_iteration;
+  //! After each vertex block's kernel (any stage) of an iteration, with the block's index. Runs on
+  //! the engine's threads, several at once: keep it short and thread-safe.
+  std::function<void(std::size_t block)> on_block;
   std::function<void(const RefineProgress&)> on_progress;
 };
 

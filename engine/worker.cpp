@@ -117,6 +117,7 @@ void Worker::run(Job& job) {
     control.logger = options_.logger;
     control.cancel = &job.cancel;
     control.on_iteration = job.spec.on_iteration;
+    control.on_block = job.spec.on_block;
     control.on_progress = [this, &job](const RefineProgress& p) {
       std::lock_guard lock(mutex_);
       job.progress.iteration = p.iteration;

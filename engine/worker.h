@@ -31,6 +31,8 @@ struct JobSpec {
   RefineOptions options;
   //! Called on the worker thread after every iteration; keep it short.
   std::function<void(const IterationReport&)> on_iteration;
+  //! RefineControl::on_block: after each vertex block's kernel, on the engine's threads.
+  std::function<void(std::size_t block)> on_block;
 };
 
 enum class JobState { Queued, Running, Succeeded, Failed, Cancelled };
