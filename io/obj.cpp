@@ -178,7 +178,10 @@ std::string texture_name(std::string_view line) {
 //! The first `map_Kd` of the material library beside the OBJ file, if the library exists.
 std::string diffuse_texture(const std::filesystem::path& obj, const std::string& library) {
   const auto path = obj.parent_path() / library;
-  if (!std::filesystem::exists(path)) return {};  // a missing .mtl only loses the texture name
+  // A missing .mtl only loses the texture name; so does a name the file system refuses (too long,
+  // a folder, ...): the error_code overload, since the throwing one escapes as filesystem_error.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return {};
   TextReader reader(path);
   while (reader.next_content_line('#')) {
     const auto t = split_whitespace(reader.line());

@@ -126,12 +126,14 @@ IndexedMesh read_off(const std::filesystem::path& file) {
   if (n_vertices > std::numeric_limits<std::uint32_t>::max()) reader.fail("too many vertices");
 
   IndexedMesh mesh;
-  mesh.positions.reserve(n_vertices);
+  // The counts are untrusted: room for no more elements than the file can hold ("0 0 0\n" is 6 bytes,
+  // "3 0 0 0\n" 8).
+  mesh.positions.reserve(reservable(n_vertices, file, 6));
   for (std::size_t v = 0; v < n_vertices; ++v) {
     if (!reader.next_content_line('#')) truncated(reader, n_vertices, "vertices", v);
     read_vertex(reader, layout, mesh);
   }
-  mesh.triangles.reserve(n_faces);
+  mesh.triangles.reserve(reservable(n_faces, file, 8));
   for (std::size_t f = 0; f < n_faces; ++f) {
     if (!reader.next_content_line('#')) truncated(reader, n_faces, "faces", f);
     read_face(reader, f, n_vertices, mesh);

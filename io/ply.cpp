@@ -389,10 +389,12 @@ struct Body {
   void prepare(const Element& element) {
     if (element.name == "vertex") {
       layout = vertex_layout(element, file);
-      mesh.positions.reserve(element.count);
+      // The count is untrusted: room for no more vertices than the file can hold (at least one byte
+      // per property), and for faces (a count and three indices) likewise.
+      mesh.positions.reserve(reservable(element.count, file, element.properties.size()));
     } else if (element.name == "face") {
       face_list = face_list_property(element, file);
-      mesh.triangles.reserve(element.count);
+      mesh.triangles.reserve(reservable(element.count, file, 4));
     }
   }
   void done(const Element& element) {

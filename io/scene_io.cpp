@@ -34,27 +34,6 @@ std::string list_names(const std::vector<fs::path>& files) {
   return text;
 }
 
-// Middlebury READMEs state the box as two lines "(x y z)".
-std::optional<BoundingBox> middlebury_readme_box(const fs::path& readme) {
-  if (!fs::is_regular_file(readme)) return std::nullopt;
-  TextReader reader(readme);
-  const std::regex triple(R"(^\s*\(\s*([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s*\)\s*$)");
-  bool after_heading = false;
-  std::vector<Eigen::Vector3d> corners;
-  while (reader.next_line() && corners.size() < 2) {
-    if (reader.line().find("bounding box") != std::string::npos) after_heading = true;
-    std::smatch match;
-    if (after_heading && std::regex_match(reader.line(), match, triple))
-      corners.emplace_back(parse_double(reader, match[1].str(), "x"), parse_double(reader, match[2].str(), "y"),
-                           parse_double(reader, match[3].str(), "z"));
-  }
-  if (corners.size() != 2) return std::nullopt;
-  BoundingBox box;
-  box.extend(corners[0]);
-  box.extend(corners[1]);
-  return box;
-}
-
 // Checks (and for size-less formats sets) each camera's image size from its file's header.
 void attach_image_sizes(Scene& scene, const fs::path& camera_folder) {
   for (std::size_t i = 0; i < scene.views.size(); ++i) {
@@ -110,11 +89,35 @@ SceneLocation locate_scene(const fs::path& path) {
 }
 
 std::optional<fs::path> find_image(const fs::path& camera_folder, const std::string& image_name) {
+  // The name comes from a camera file: one the file system refuses (too long, ...) is not found,
+  // rather than a filesystem_error from the throwing overloads.
   const fs::path name(image_name);
-  if (name.is_absolute()) return fs::is_regular_file(name) ? std::optional(name) : std::nullopt;
+  std::error_code error;
+  if (name.is_absolute()) return fs::is_regular_file(name, error) ? std::optional(name) : std::nullopt;
   for (const fs::path& candidate : {camera_folder / name, camera_folder / "images" / name})
-    if (fs::is_regular_file(candidate)) return candidate;
+    if (fs::is_regular_file(candidate, error)) return candidate;
   return std::nullopt;
+}
+
+// Middlebury READMEs state the box as two lines "(x y z)".
+std::optional<BoundingBox> read_middlebury_readme_box(const fs::path& readme) {
+  if (!fs::is_regular_file(readme)) return std::nullopt;
+  TextReader reader(readme);
+  const std::regex triple(R"(^\s*\(\s*([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s*\)\s*$)");
+  bool after_heading = false;
+  std::vector<Eigen::Vector3d> corners;
+  while (reader.next_line() && corners.size() < 2) {
+    if (reader.line().find("bounding box") != std::string::npos) after_heading = true;
+    std::smatch match;
+    if (after_heading && std::regex_match(reader.line(), match, triple))
+      corners.emplace_back(parse_double(reader, match[1].str(), "x"), parse_double(reader, match[2].str(), "y"),
+                           parse_double(reader, match[3].str(), "z"));
+  }
+  if (corners.size() != 2) return std::nullopt;
+  BoundingBox box;
+  box.extend(corners[0]);
+  box.extend(corners[1]);
+  return box;
 }
 
 BoundingBox read_bounding_box(const fs::path& file) {
@@ -194,7 +197,7 @@ Scene load_scene(const fs::path& path, const SceneLoadOptions& options) {
   if (fs::is_regular_file(scene.folder / "bbox.txt")) {
     scene.bounding_box = read_bounding_box(scene.folder / "bbox.txt");
     scene.bounding_box_source = (scene.folder / "bbox.txt").string();
-  } else if (auto box = middlebury_readme_box(scene.folder / "README.txt")) {
+  } else if (auto box = read_middlebury_readme_box(scene.folder / "README.txt")) {
     scene.bounding_box = *box;
     scene.bounding_box_source = (scene.folder / "README.txt").string();
   } else {

@@ -44,6 +44,9 @@ std::optional<std::filesystem::path> find_image(const std::filesystem::path& cam
 
 //! Reads `bbox.txt`-style text (six numbers). \throw InputError.
 BoundingBox read_bounding_box(const std::filesystem::path& file);
+//! The box a Middlebury README states: the first two lines "(x y z)" after a line holding
+//! "bounding box". nullopt when the file does not exist or states no box. \throw InputError.
+std::optional<BoundingBox> read_middlebury_readme_box(const std::filesystem::path& readme);
 
 //! A box that every camera sees: the point nearest to all optical axes (least squares) and a
 //! half size from the narrowest field of view at that distance. Empty when it cannot be found.

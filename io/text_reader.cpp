@@ -1,5 +1,6 @@
 #include "io/text_reader.h"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -68,6 +69,13 @@ long long parse_integer(const TextReader& reader, std::string_view token, const 
     reader.fail("expected an integer for " + what + ", got '" + std::string(token) + "'");
   if (value < 0) reader.fail("expected a non-negative integer for " + what + ", got '" + std::string(token) + "'");
   return value;
+}
+
+std::size_t reservable(std::size_t count, const std::filesystem::path& file, std::size_t min_bytes) {
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(file, error);
+  if (error) return 0;
+  return static_cast<std::size_t>(std::min<std::uintmax_t>(count, size / std::max<std::size_t>(min_bytes, 1)));
 }
 
 }  // namespace mvflow::io

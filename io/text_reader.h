@@ -46,4 +46,9 @@ double parse_double(const TextReader& reader, std::string_view token, const std:
 //! Parses a non-negative integer that fits in long long, the same way.
 long long parse_integer(const TextReader& reader, std::string_view token, const std::string& what);
 
+//! How many of \p count elements to reserve room for when each takes at least \p min_bytes bytes
+//! of \p file: never more than the file can hold, so that a count in a header ("element vertex
+//! 215155252") allocates nothing beyond what the file really contains.
+std::size_t reservable(std::size_t count, const std::filesystem::path& file, std::size_t min_bytes);
+
 }  // namespace mvflow::io

@@ -5,6 +5,7 @@ set -euo pipefail
 
 packages=(
   g++ cmake ninja-build ccache pkg-config
+  clang libclang-rt-14-dev
   libeigen3-dev libtbb-dev libopenmesh-dev libopencv-dev libembree-dev
   libspdlog-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
