@@ -53,6 +53,7 @@ struct SurfaceQuery::Embree {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   RTCGeometry geometry = nullptr;
+  bool attached = false;      // the scene holds the geometry's reference (set once released to it)
   float* vertices = nullptr;  // Embree-owned buffer, 3 floats per vertex (+ padding)
 
   void check(const char* what) {
@@ -60,6 +61,9 @@ struct SurfaceQuery::Embree {
     if (!errors.message.empty()) throw Error(std::string(what) + ": " + errors.message);
   }
   ~Embree() {
+    // A constructor that threw (a non-finite vertex, an Embree error) before handing the geometry
+    // to the scene still holds it, and through it the device.
+    if (geometry && !attached) rtcReleaseGeometry(geometry);
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
   }
@@ -96,6 +100,7 @@ SurfaceQuery::SurfaceQuery(const std::vector<Eigen::Vector3d>& positions,
   upload_positions();
   rtcAttachGeometry(e.scene, e.geometry);
   rtcReleaseGeometry(e.geometry);  // the scene holds the reference now
+  e.attached = true;
   rtcCommitScene(e.scene);
   e.check("building the Embree scene");
 }
