@@ -22,7 +22,9 @@ bool TextReader::next_line() {
 
 bool TextReader::next_content_line(char comment) {
   while (next_line()) {
-    const auto first = line_.find_first_not_of(" \t\f\v");
+    // The whitespace of split_whitespace (std::isspace): a line of a lone '\r' is blank too, not a
+    // content line with no token.
+    const auto first = line_.find_first_not_of(" \t\n\v\f\r");
     if (first == std::string::npos) continue;
     if (comment != 0 && line_[first] == comment) continue;
     return true;

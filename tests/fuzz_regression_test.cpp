@@ -97,6 +97,19 @@ TEST(FuzzRegression, OffVertexCountBeyondTheFile) {
   EXPECT_LT(largest_allocation_of([&] { read_off(file); }), 1u << 20);
 }
 
+// off_fuzzer: "\r\r\nC\nC" (a first line of a lone '\r' once the line ending is removed) was a
+// content line to TextReader but held no token for split_whitespace, so read_off took the first
+// token of an empty list (UBSan: reference binding to null pointer). Blank now, as in every reader.
+TEST(FuzzRegression, OffLineOfCarriageReturns) {
+  ScratchFolder folder;
+  const fs::path file = folder / "mesh.off";
+  write_text(file, "\r\r\nC\nC");
+  const std::string message = input_error_of([&] { read_off(file); });
+  EXPECT_TRUE(contains(message, file.string() + ":2:")) << message;
+  write_text(file, "OFF\r\n\r\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n\v\r\r\n0 1 0\r\n3 0 1 2\r\n");
+  EXPECT_EQ(read_off(file).triangles.size(), 1u);
+}
+
 // The same count in a PLY header (found by reading ply.cpp after the OFF finding: both reserved
 // room for the header's count).
 TEST(FuzzRegression, PlyElementCountBeyondTheFile) {
