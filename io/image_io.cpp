@@ -1,6 +1,8 @@
 #include "io/image_io.h"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdint>
 #include <fstream>
 #include <vector>
@@ -40,15 +42,29 @@ std::optional<HeaderSize> png_size(std::istream& in) {
 }
 
 // JPEG: walk the marker segments to the first start-of-frame (SOF0..SOF15 except DHT/JPG/DAC).
+// Bytes before a marker are skipped as libjpeg skips them ("extraneous bytes before marker"), so
+// that every file libjpeg would decode has its size checked here first.
 std::optional<HeaderSize> jpeg_size(std::istream& in) {
   unsigned char soi[2];
   if (!in.read(reinterpret_cast<char*>(soi), 2) || soi[0] != 0xFF || soi[1] != 0xD8) return std::nullopt;
-  for (int segments = 0; segments < 1000; ++segments) {
-    unsigned char marker[4];
-    if (!in.read(reinterpret_cast<char*>(marker), 4) || marker[0] != 0xFF) return std::nullopt;
-    const int type = marker[1];
-    const int length = (marker[2] << 8) | marker[3];
-    if (length < 2) return std::nullopt;
+  const auto next_byte = [&in]() -> std::optional<int> {
+    const int c = in.get();
+    if (c == std::char_traits<char>::eof()) return std::nullopt;
+    return c;
+  };
+  for (int segments = 0; segments < 100000; ++segments) {
+    std::optional<int> c = next_byte();
+    while (c && *c != 0xFF) c = next_byte();  // extraneous bytes
+    while (c && *c == 0xFF) c = next_byte();  // fill bytes
+    if (!c) return std::nullopt;
+    const int type = *c;
+    const bool standalone = type == 0x00 || type == 0x01 || (type >= 0xD0 && type <= 0xD8);
+    if (standalone) continue;
+    if (type == 0xD9) return std::nullopt;  // end of image before any frame
+    unsigned char length_bytes[2];
+    if (!in.read(reinterpret_cast<char*>(length_bytes), 2)) return std::nullopt;
+    const int length = (length_bytes[0] << 8) | length_bytes[1];
+    if (length < 2) continue;  // libjpeg reads on: scan for the next marker
     const bool is_frame = type >= 0xC0 && type <= 0xCF && type != 0xC4 && type != 0xC8 && type != 0xCC;
     if (is_frame) {
       unsigned char frame[5];
@@ -61,14 +77,82 @@ std::optional<HeaderSize> jpeg_size(std::istream& in) {
   return std::nullopt;
 }
 
-// The size a PNG or JPEG header states, without decoding; nullopt for other formats.
+std::uint32_t little_endian_32(const unsigned char* p) {
+  return std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) | (std::uint32_t{p[3]} << 24);
+}
+
+// BMP: the info header's width and height (signed; a negative height is a top-down image) follow
+// the 14-byte file header; the old 12-byte core header has 16-bit ones.
+std::optional<HeaderSize> bmp_size(std::istream& in) {
+  std::array<unsigned char, 26> header{};
+  if (!in.read(reinterpret_cast<char*>(header.data()), header.size())) return std::nullopt;
+  if (header[0] != 'B' || header[1] != 'M') return std::nullopt;
+  if (little_endian_32(&header[14]) == 12)
+    return HeaderSize{std::uint32_t{header[18]} | (std::uint32_t{header[19]} << 8),
+                      std::uint32_t{header[20]} | (std::uint32_t{header[21]} << 8)};
+  const auto magnitude = [](std::uint32_t value) {
+    const auto signed_value = static_cast<std::int64_t>(static_cast<std::int32_t>(value));
+    return static_cast<std::uint32_t>(signed_value < 0 ? -signed_value : signed_value);
+  };
+  return HeaderSize{magnitude(little_endian_32(&header[18])), magnitude(little_endian_32(&header[22]))};
+}
+
+// PNM (P1..P6): magic, then width and height as decimal numbers between whitespace and comments.
+std::optional<HeaderSize> pnm_size(std::istream& in) {
+  char magic[2];
+  if (!in.read(magic, 2) || magic[0] != 'P' || magic[1] < '1' || magic[1] > '6') return std::nullopt;
+  std::array<std::uint64_t, 2> numbers{};
+  for (std::uint64_t& number : numbers) {
+    int c = in.get();
+    while (c == '#' || std::isspace(c)) {
+      if (c == '#')
+        while (c != '\n' && c != std::char_traits<char>::eof()) c = in.get();
+      c = in.get();
+    }
+    if (!std::isdigit(c)) return std::nullopt;
+    for (; std::isdigit(c); c = in.get()) number = std::min<std::uint64_t>(number * 10 + (c - '0'), 1ULL << 32);
+  }
+  return HeaderSize{static_cast<std::uint32_t>(std::min<std::uint64_t>(numbers[0], UINT32_MAX)),
+                    static_cast<std::uint32_t>(std::min<std::uint64_t>(numbers[1], UINT32_MAX))};
+}
+
+// TIFF (classic, either byte order): tags 256 and 257 (width, height) of the first image directory.
+std::optional<HeaderSize> tiff_size(std::istream& in) {
+  std::array<unsigned char, 8> header{};
+  if (!in.read(reinterpret_cast<char*>(header.data()), header.size())) return std::nullopt;
+  const bool little = header[0] == 'I' && header[1] == 'I' && header[2] == 42 && header[3] == 0;
+  const bool big = header[0] == 'M' && header[1] == 'M' && header[2] == 0 && header[3] == 42;
+  if (!little && !big) return std::nullopt;
+  const auto u16 = [little](const unsigned char* p) {
+    return static_cast<std::uint32_t>(little ? p[0] | (p[1] << 8) : (p[0] << 8) | p[1]);
+  };
+  const auto u32 = [little](const unsigned char* p) { return little ? little_endian_32(p) : big_endian_32(p); };
+  in.seekg(u32(&header[4]));
+  unsigned char count_bytes[2];
+  if (!in.read(reinterpret_cast<char*>(count_bytes), 2)) return std::nullopt;
+  std::optional<std::uint32_t> width, height;
+  for (std::uint32_t i = 0, n = u16(count_bytes); i < n; ++i) {
+    unsigned char entry[12];
+    if (!in.read(reinterpret_cast<char*>(entry), 12)) return std::nullopt;
+    const std::uint32_t tag = u16(entry), type = u16(entry + 2);
+    if (tag != 256 && tag != 257) continue;
+    const std::uint32_t value = type == 3 ? u16(entry + 8) : type == 4 ? u32(entry + 8) : 0;
+    (tag == 256 ? width : height) = value;
+  }
+  if (!width || !height) return std::nullopt;
+  return HeaderSize{*width, *height};
+}
+
+// The size a PNG, JPEG, BMP, PNM or TIFF header states, without decoding; nullopt for other formats.
 std::optional<HeaderSize> header_size(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw IoError(file, "cannot open for reading");
-  if (auto size = png_size(in)) return size;
-  in.clear();
-  in.seekg(0);
-  return jpeg_size(in);
+  for (const auto reader : {png_size, jpeg_size, bmp_size, pnm_size, tiff_size}) {
+    in.clear();
+    in.seekg(0);
+    if (auto size = reader(in)) return size;
+  }
+  return std::nullopt;
 }
 
 // Refuses a size beyond kMaxImageSide / kMaxImagePixels, naming the file.
@@ -82,13 +166,29 @@ void check_image_size(const std::filesystem::path& file, std::uint64_t width, st
                        " in all are read");
 }
 
+// The size the header states, refused when beyond the limits or when the format is not one whose
+// header is read here.
+HeaderSize stated_size(const std::filesystem::path& file) {
+  const auto size = header_size(file);
+  if (!size)
+    throw InputError(file, 0,
+                     "cannot decode the image: no PNG, JPEG, TIFF, BMP or PNM header (the formats read) or a damaged one");
+  check_image_size(file, size->width, size->height);
+  return *size;
+}
+
 }  // namespace
 
 Image read_image(const std::filesystem::path& file) {
   require_file(file);
-  // The header's size first, so that a huge image is refused before anything is allocated.
-  if (const auto size = header_size(file)) check_image_size(file, size->width, size->height);
-  const cv::Mat decoded = cv::imread(file.string(), cv::IMREAD_COLOR | cv::IMREAD_ANYDEPTH);
+  stated_size(file);  // first, so that a huge image is refused before anything is allocated
+  cv::Mat decoded;
+  try {
+    decoded = cv::imread(file.string(), cv::IMREAD_COLOR | cv::IMREAD_ANYDEPTH);
+  } catch (const cv::Exception& error) {
+    // OpenCV refuses some files by throwing (its own size limit, assertions in its decoders).
+    throw InputError(file, 0, "cannot decode the image: " + error.err);
+  }
   if (decoded.empty())
     throw InputError(file, 0, "cannot decode the image (unreadable, truncated or not an image format OpenCV reads)");
   double scale = 1.0;
@@ -109,12 +209,8 @@ Image read_image(const std::filesystem::path& file) {
 
 ImageSize read_image_size(const std::filesystem::path& file) {
   require_file(file);
-  if (const auto size = header_size(file)) {
-    check_image_size(file, size->width, size->height);
-    return {static_cast<int>(size->width), static_cast<int>(size->height)};
-  }
-  const Image image = read_image(file);
-  return {image.width(), image.height()};
+  const HeaderSize size = stated_size(file);
+  return {static_cast<int>(size.width), static_cast<int>(size.height)};
 }
 
 void write_png(const std::filesystem::path& file, const Image& image, int bits) {

@@ -1,7 +1,7 @@
 #pragma once
 // Silhouette mask files: one image per view in a folder, matched to the view's photograph by
-// file-name stem (dinoSR0001.png ↔ masks/dinoSR0001.png, .pgm, .jpg, ...). Any image OpenCV
-// decodes; a pixel whose largest channel is non-zero is object (stages/silhouette.h turns the
+// file-name stem (dinoSR0001.png ↔ masks/dinoSR0001.png, .pgm, .jpg, ...). Any image read_image
+// reads (io/image_io.h); a pixel whose largest channel is non-zero is object (stages/silhouette.h turns the
 // image into a mask).
 
 #include <filesystem>

@@ -7,11 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <string>
 
 #include "engine/error.h"
+#include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
 #include "tests/test_support.h"
@@ -123,6 +125,107 @@ TEST(FuzzRegression, PlyElementCountBeyondTheFile) {
     EXPECT_TRUE(contains(message, file.string())) << message;
     EXPECT_LT(largest_allocation_of([&] { read_ply(file); }), 1u << 20) << format;
   }
+}
+
+// mask_fuzzer (CI, 2026-11-24): a JPEG with extraneous bytes between its segments stating
+// 64264x58885 pixels. mvflow's header reader gave up at the stray bytes, libjpeg skips them, and
+// OpenCV's own size limit then threw a cv::Exception out of read_image (uncaught: abort). The header
+// reader now skips such bytes as libjpeg does, so the size is refused before decoding, naming the file.
+TEST(FuzzRegression, JpegWithExtraneousBytesStatingAHugeSize) {
+  ScratchFolder folder;
+  const fs::path file = folder / "mask.jpg";
+  const std::string jpeg(
+      "\xff\xd8\xff\xe0\x00\x10JFIF\x00\x01\x01\xef\x00\x00\x01\x00\x01\x00\x00\xff\xdb\x00\x43\x00\x02\x01\x01\x01"
+      "\x01\x01\x02\x01\x01\x01\x02\x02\x02\x02\x02\x04\x03\x03\x02\x05\x02\x02\x04\x04\x03\x04\x06\x05\x06\x06\x06"
+      "\x05\x06\x06\x06\x07\x09\x08\x06\x07\x09\x07\x06\x06\x08\x0b\x00\x09\x0a\x0a\x0a\x0a\x0a\x06\x08\x0b\x0c\x0b"
+      "\x0a\x0c\x09\x0a\x0a\x0a\xff\xc0\x00\x0b\x08\xe6\x05\xfb\x08\x01\x01\x11\x00\x63\x64\x65\x66\x67\x68\xf8\xf6"
+      "\xf7\xfa\xff\xda\x00\x08\x01\x01\x00\x00\x3f\x52\x00\x00\x82\x4a\x83\x83\x00\x00\xf4\xcb\x5f\xff\xd9",
+      136);
+  write_text(file, jpeg);
+  for (const bool size_only : {true, false}) {
+    const std::string message = input_error_of([&] {
+      if (size_only)
+        read_image_size(file);
+      else
+        read_image(file);
+    });
+    EXPECT_TRUE(contains(message, file.string())) << message;
+    EXPECT_TRUE(contains(message, "64264x58885")) << message;
+  }
+}
+
+// A BMP stating 40000x40000 pixels: refused from mvflow's own reading of its header.
+TEST(FuzzRegression, HugeBmpRefusedFromItsHeader) {
+  ScratchFolder folder;
+  const fs::path file = folder / "mask.bmp";
+  std::string bmp(54, '\0');
+  const auto put32 = [&bmp](std::size_t at, std::uint32_t value) {
+    for (int i = 0; i < 4; ++i) bmp[at + i] = static_cast<char>((value >> (8 * i)) & 0xFF);
+  };
+  bmp[0] = 'B';
+  bmp[1] = 'M';
+  put32(2, 54);        // file size (not checked by OpenCV)
+  put32(10, 54);       // offset of the pixels
+  put32(14, 40);       // BITMAPINFOHEADER
+  put32(18, 40000);    // width
+  put32(22, 40000);    // height
+  bmp[26] = 1;         // planes
+  bmp[28] = 24;        // bits per pixel
+  write_text(file, bmp);
+  const std::string message = input_error_of([&] { read_image(file); });
+  EXPECT_TRUE(contains(message, file.string() + ": the image is 40000x40000 pixels")) << message;
+  EXPECT_LT(largest_allocation_of([&] { read_image(file); }), 1u << 20);
+  write_text(file, "P5\n# comment\n 40000\t40000 255\n");  // the same size in a PGM
+  EXPECT_TRUE(contains(input_error_of([&] { read_image(file); }), "40000x40000")) << message;
+}
+
+// mask_fuzzer (2026-11-24): a JPEG whose APP0 length is 0 (libjpeg reads on) stating 64264x11525
+// pixels, 740 M, below OpenCV's default limit of 2^30: OpenCV allocated 2.2 GB. The program's
+// setting of OpenCV's limit had no effect (a misnamed variable, and OpenCV reads it only when it is
+// loaded), so mvflow now reads the size from the header of every format it accepts, refuses the
+// others, and its JPEG reader reads on as libjpeg does. A TIFF stating 20000x20000 pixels (in
+// either byte order) and an image in a format mvflow does not read (Radiance HDR) are refused
+// before allocating.
+TEST(FuzzRegression, JpegWithZeroSegmentLengthTiffAndOtherFormats) {
+  ScratchFolder folder;
+  const fs::path jpeg_file = folder / "mask.jpg";
+  write_text(jpeg_file, std::string("\xff\xd8\xff\xe0\x00\x00\xff\xc0\x00\x0b\x08\x2d\x05\xfb\x08\x01\x01\x11\x00\xff\xd9", 21));
+  EXPECT_TRUE(contains(input_error_of([&] { read_image(jpeg_file); }), "64264x11525"));
+
+  const fs::path tiff_file = folder / "mask.tif";
+  for (const bool little : {true, false}) {
+    std::string tiff = little ? std::string("II*\0\x08\0\0\0", 8) : std::string("MM\0*\0\0\0\x08", 8);
+    const auto put16 = [&](std::uint16_t v) {
+      const char low = static_cast<char>(v & 0xFF), high = static_cast<char>(v >> 8);
+      tiff += little ? low : high;
+      tiff += little ? high : low;
+    };
+    const auto put32 = [&](std::uint32_t v) {
+      little ? (put16(v & 0xFFFF), put16(v >> 16)) : (put16(v >> 16), put16(v & 0xFFFF));
+    };
+    const auto entry = [&](std::uint16_t tag, std::uint16_t type, std::uint32_t value) {
+      put16(tag), put16(type), put32(1);
+      type == 3 ? (put16(static_cast<std::uint16_t>(value)), put16(0)) : put32(value);
+    };
+    put16(6);
+    entry(256, 4, 20000);      // width, a LONG
+    entry(257, 3, 20000);      // height, a SHORT
+    entry(258, 3, 8);          // bits per sample
+    entry(262, 3, 1);          // black is zero
+    entry(273, 4, 200);        // strip offset
+    entry(279, 4, 400000000);  // strip byte count
+    put32(0);
+    write_text(tiff_file, tiff);
+    const std::string message = input_error_of([&] { read_image(tiff_file); });
+    EXPECT_TRUE(contains(message, tiff_file.string() + ": the image is 20000x20000 pixels")) << message;
+    EXPECT_LT(largest_allocation_of([&] { read_image(tiff_file); }), 1u << 20);
+  }
+
+  const fs::path hdr_file = folder / "mask.hdr";
+  write_text(hdr_file, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n");
+  const std::string message = input_error_of([&] { read_image_size(hdr_file); });
+  EXPECT_TRUE(contains(message, "no PNG, JPEG, TIFF, BMP or PNM header")) << message;
+  EXPECT_LT(largest_allocation_of([&] { read_image(hdr_file); }), 1u << 20);
 }
 
 }  // namespace

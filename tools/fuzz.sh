@@ -6,6 +6,8 @@
 # (build-fuzz/corpus/TARGET); SECONDS = 0 only replays them. A crash, sanitizer report, uncaught exception other than mvflow's
 # InputError/IoError, input slower than 10 s or memory beyond 2 GB is a finding: its input goes to
 # build-fuzz/findings/TARGET/ and the script fails after running the other targets.
+# MVFLOW_FUZZ_SEED fixes libFuzzer's random seed (tools/check.sh does, so that its short run makes
+# the same mutations on every machine and a finding there can be replayed); unset, each run differs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-600}
@@ -34,6 +36,7 @@ for target in "${targets[@]}"; do
   status=0
   duration=(-max_total_time="$seconds")
   [ "$seconds" -eq 0 ] && duration=(-runs=0)
+  [ -n "${MVFLOW_FUZZ_SEED:-}" ] && duration+=(-seed="$MVFLOW_FUZZ_SEED")
   nice -n 15 "$build/tests/fuzz/${target}_fuzzer" "${duration[@]}" -timeout=10 -rss_limit_mb=2048 \
     -max_len=8192 -print_final_stats=1 -artifact_prefix="$findings/" "$corpus" "$build/seeds/$target" \
     >"$log" 2>&1 || status=$?

@@ -19,10 +19,6 @@
 
 int main(int argc, char** argv) {
   using namespace mvflow::cli;
-  // OpenCV's decoders allocate what a header claims up to 2^30 pixels; photographs beyond
-  // io::kMaxImagePixels are refused anyway, so let OpenCV refuse them before allocating (a
-  // value already in the environment wins).
-  setenv("CV_IO_MAX_IMAGE_PIXELS", std::to_string(mvflow::io::kMaxImagePixels).c_str(), 0);
   CLI::App app{"mvflow: refines a coarse mesh of an object into a photo-consistent surface, from calibrated photographs"};
   std::string kernel;
   try {

@@ -9,11 +9,6 @@
 #include "tests/fuzz/fuzz_support.h"
 #include "tests/fuzz/sample_views.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  // As the program does (tools/main.cpp): OpenCV's own decoding limit.
-  setenv("CV_IO_MAX_IMAGE_PIXELS", std::to_string(mvflow::io::kMaxImagePixels).c_str(), 0);
-  return 0;
-}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static constexpr std::array<const char*, 6> kExtensions{".png", ".jpg", ".pgm", ".ppm", ".bmp", ".tif"};
