@@ -133,7 +133,7 @@ class Refinement {
     RefineSummary& summary = result.summary;
     summary.initial_vertices = mesh_.n_vertices();
     summary.initial_faces = mesh_.n_faces();
-    progress(0, "preparing");
+    progress(0, RefineStage::Preparing);
     prepare();
     summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, options_).sum_g_per_vertex;
 
@@ -186,7 +186,7 @@ class Refinement {
       }
     }
 
-    progress(static_cast<int>(summary.iterations.size()), "finishing");
+    progress(static_cast<int>(summary.iterations.size()), RefineStage::Finishing);
     if (status != RefineStatus::Cancelled) spread_unobserved();
     const std::optional<UntanglingResult> untangled =
         status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
@@ -209,7 +209,7 @@ class Refinement {
  private:
   bool cancelled() const { return control_.cancel && control_.cancel->load(); }
 
-  void progress(int iteration, const char* stage) {
+  void progress(int iteration, RefineStage stage) {
     if (!control_.on_progress) return;
     RefineProgress p;
     p.iteration = iteration;
@@ -346,14 +346,14 @@ class Refinement {
       control_.logger->info("iteration {:3d}  vertices {:7d}  Σg/vertex {:.6g}  Δt {:.4g}  max|F| {:.4g}  {:.3f} s",
                             report.iteration, report.vertices, report.sum_g_per_vertex(), report.time_step,
                             report.max_speed, report.seconds);
-    if (control_.on_iteration) control_.on_iteration(report);
     RefineProgress p;
     p.iteration = report.iteration;
     p.max_iterations = options_.stopping.max_iterations;
     p.vertices = report.vertices;
     p.sum_g_per_vertex = report.sum_g_per_vertex();
-    p.stage = "iterating";
-    if (control_.on_progress) control_.on_progress(p);
+    p.stage = RefineStage::Iterating;
+    if (control_.on_progress) control_.on_progress(p);  // first: on_iteration sees the same state
+    if (control_.on_iteration) control_.on_iteration(report);
   }
 
   const RefineOptions& options_;
@@ -374,6 +374,15 @@ class Refinement {
 };
 
 }  // namespace
+
+const char* to_string(RefineStage stage) {
+  switch (stage) {
+    case RefineStage::Preparing: return "preparing";
+    case RefineStage::Iterating: return "iterating";
+    case RefineStage::Finishing: return "finishing";
+  }
+  return "?";
+}
 
 RefineResult refine_mesh(const Scene& scene, const Mesh& initial, const RefineOptions& options,
                          const RefineControl& control) {

@@ -16,13 +16,17 @@
 
 namespace mvflow {
 
+//! What a run is doing (RefineProgress::stage; the worker's JobProgress adds Loading).
+enum class RefineStage { Preparing, Iterating, Finishing };
+const char* to_string(RefineStage stage);  //!< "preparing", "iterating", "finishing"
+
 //! Where the refinement stands, for progress displays.
 struct RefineProgress {
   int iteration = 0;          //!< 0 while preparing
   int max_iterations = 0;
   std::size_t vertices = 0;
   double sum_g_per_vertex = 0.0;
-  const char* stage = "";     //!< "preparing", "iterating", "finishing"
+  RefineStage stage = RefineStage::Preparing;
 };
 
 //! How the caller steers and watches a run. Everything is optional.

@@ -12,9 +12,35 @@ struct Worker::Job {
   JobId id = 0;
   JobSpec spec;
   std::atomic<bool> cancel{false};
-  JobProgress progress;              // guarded by Worker::mutex_
-  std::optional<JobOutcome> outcome;  // guarded by Worker::mutex_
+  JobProgress progress;  // guarded by Worker::mutex_
+  // Set once, under Worker::mutex_, and never changed after: readers copy it outside the lock.
+  std::shared_ptr<const JobOutcome> outcome;
+  bool taken = false;  // guarded by Worker::mutex_: take() has removed the outcome
 };
+
+namespace {
+
+JobStage job_stage(RefineStage stage) {
+  switch (stage) {
+    case RefineStage::Preparing: return JobStage::Preparing;
+    case RefineStage::Iterating: return JobStage::Iterating;
+    case RefineStage::Finishing: return JobStage::Finishing;
+  }
+  return JobStage::None;
+}
+
+}  // namespace
+
+const char* to_string(JobStage stage) {
+  switch (stage) {
+    case JobStage::None: return "";
+    case JobStage::Loading: return "loading";
+    case JobStage::Preparing: return "preparing";
+    case JobStage::Iterating: return "iterating";
+    case JobStage::Finishing: return "finishing";
+  }
+  return "?";
+}
 
 const char* to_string(JobState state) {
   switch (state) {
@@ -52,32 +78,68 @@ Worker::JobId Worker::submit(JobSpec spec) {
   return job->id;
 }
 
-Worker::Job& Worker::find(JobId id) const {
+std::shared_ptr<Worker::Job> Worker::find(JobId id) const {
   const auto found = jobs_.find(id);
   MVFLOW_CHECK(found != jobs_.end(), "unknown job id " + std::to_string(id));
-  return *found->second;
+  return found->second;
 }
 
 JobProgress Worker::progress(JobId id) const {
   std::lock_guard lock(mutex_);
-  return find(id).progress;
+  return find(id)->progress;
 }
 
 void Worker::cancel(JobId id) {
   std::lock_guard lock(mutex_);
-  find(id).cancel = true;
+  find(id)->cancel = true;
+}
+
+std::shared_ptr<const JobOutcome> Worker::finished(const std::shared_ptr<Job>& job) {
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [&] { return job->outcome != nullptr || job->taken; });
+  MVFLOW_CHECK(!job->taken, "job " + std::to_string(job->id) + " was taken by another thread");
+  return job->outcome;
 }
 
 JobOutcome Worker::wait(JobId id) {
-  std::unique_lock lock(mutex_);
-  Job& job = find(id);
-  changed_.wait(lock, [&] { return job.outcome.has_value(); });
-  return *job.outcome;
+  std::shared_ptr<Job> job;
+  {
+    std::lock_guard lock(mutex_);
+    job = find(id);
+  }
+  return *finished(job);  // copied outside the lock
 }
 
 std::optional<JobOutcome> Worker::try_result(JobId id) const {
-  std::lock_guard lock(mutex_);
-  return find(id).outcome;
+  std::shared_ptr<const JobOutcome> outcome;
+  {
+    std::lock_guard lock(mutex_);
+    outcome = find(id)->outcome;
+  }
+  if (!outcome) return std::nullopt;
+  return *outcome;
+}
+
+JobOutcome Worker::take(JobId id) {
+  std::shared_ptr<Job> job;
+  {
+    std::lock_guard lock(mutex_);
+    job = find(id);
+  }
+  std::shared_ptr<const JobOutcome> outcome = finished(job);
+  {
+    std::lock_guard lock(mutex_);
+    if (job->taken) outcome.reset();  // another take() was first
+    job->taken = true;
+    job->outcome.reset();
+    jobs_.erase(id);  // from now on nobody can reach the outcome but the holders of a copy
+  }
+  // Sole owner: move it out (it was made non-const, only handed out as const). A wait() or
+  // try_result() still copying it on another thread keeps it shared: copy then.
+  changed_.notify_all();  // a wait() on this job now fails instead of waiting forever
+  MVFLOW_CHECK(outcome != nullptr, "job " + std::to_string(id) + " was taken by another thread");
+  if (outcome.use_count() == 1) return std::move(const_cast<JobOutcome&>(*outcome));
+  return *outcome;
 }
 
 void Worker::run_jobs() {
@@ -91,12 +153,13 @@ void Worker::run_jobs() {
       queue_.pop_front();
       if (job->cancel) {  // cancelled while queued (or the worker is shutting down)
         job->progress.state = JobState::Cancelled;
-        job->outcome = JobOutcome{JobState::Cancelled, "cancelled before it started", {}, {}};
+        job->outcome =
+            std::make_shared<JobOutcome>(JobOutcome{JobState::Cancelled, "cancelled before it started", {}, {}});
         changed_.notify_all();
         continue;
       }
       job->progress.state = JobState::Running;
-      job->progress.stage = "loading";
+      job->progress.stage = JobStage::Loading;
     }
     run(*job);
     changed_.notify_all();
@@ -106,11 +169,15 @@ void Worker::run_jobs() {
 void Worker::run(Job& job) {
   JobOutcome outcome;
   try {
-    const Scene scene = io::load_scene(job.spec.scene);
-    std::filesystem::path mesh_file = job.spec.mesh;
-    if (mesh_file.empty() && scene.mesh_file) mesh_file = *scene.mesh_file;
-    if (mesh_file.empty()) throw InputError(job.spec.scene, 0, "no initial mesh given and no init.* in the scene");
-    const Mesh initial = io::load_mesh(mesh_file);
+    const std::shared_ptr<const Scene> scene =
+        job.spec.scene_data ? job.spec.scene_data : std::make_shared<const Scene>(io::load_scene(job.spec.scene));
+    std::shared_ptr<const Mesh> initial = job.spec.mesh_data;
+    if (!initial) {
+      std::filesystem::path mesh_file = job.spec.mesh;
+      if (mesh_file.empty() && scene->mesh_file) mesh_file = *scene->mesh_file;
+      if (mesh_file.empty()) throw InputError(job.spec.scene, 0, "no initial mesh given and no init.* in the scene");
+      initial = std::make_shared<const Mesh>(io::load_mesh(mesh_file));
+    }
 
     RefineControl control;
     control.threads = options_.threads;
@@ -123,9 +190,9 @@ void Worker::run(Job& job) {
       job.progress.iteration = p.iteration;
       job.progress.vertices = p.vertices;
       job.progress.sum_g_per_vertex = p.sum_g_per_vertex;
-      job.progress.stage = p.stage;
+      job.progress.stage = job_stage(p.stage);
     };
-    RefineResult result = refine_mesh(scene, initial, job.spec.options, control);
+    RefineResult result = refine_mesh(*scene, *initial, job.spec.options, control);
     outcome.summary = std::move(result.summary);
     outcome.message = outcome.summary.message;
     outcome.state = outcome.summary.status == RefineStatus::Failed      ? JobState::Failed
@@ -140,8 +207,8 @@ void Worker::run(Job& job) {
     options_.logger->error("job {}: {}", job.id, outcome.message);
   std::lock_guard lock(mutex_);
   job.progress.state = outcome.state;
-  job.progress.stage.clear();
-  job.outcome = std::move(outcome);
+  job.progress.stage = JobStage::None;
+  job.outcome = std::make_shared<JobOutcome>(std::move(outcome));  // not const: take() may move it
 }
 
 }  // namespace mvflow

@@ -1,6 +1,6 @@
 #pragma once
 // A background worker for programs that embed mvflow: submit refinement jobs from any thread,
-// watch their progress, cancel them, wait for their results. Jobs run one after another on the
+// watch their progress, cancel them, wait for or take their results. Jobs run one after another on the
 // worker's own thread, inside the engine's own task arena; nothing blocks the caller except
 // wait(), and no exception from a job reaches the host (a failed job reports its message).
 //
@@ -25,9 +25,13 @@
 
 namespace mvflow {
 
+//! A refinement job: the scene and the initial mesh either as files (read on the worker thread)
+//! or already in memory (shared, not copied: the host may keep and read them, not change them).
 struct JobSpec {
-  std::filesystem::path scene;  //!< scene folder or camera file (loaded on the worker thread)
-  std::filesystem::path mesh;   //!< initial mesh; empty: the scene's init.*
+  std::filesystem::path scene;  //!< scene folder or camera file; ignored when scene_data is set
+  std::filesystem::path mesh;   //!< initial mesh; empty: the scene's init.*; ignored when mesh_data is set
+  std::shared_ptr<const Scene> scene_data;  //!< an in-memory scene (e.g. in_memory_scene())
+  std::shared_ptr<const Mesh> mesh_data;    //!< an in-memory initial mesh
   RefineOptions options;
   //! Called on the worker thread after every iteration; keep it short.
   std::function<void(const IterationReport&)> on_iteration;
@@ -38,12 +42,16 @@ struct JobSpec {
 enum class JobState { Queued, Running, Succeeded, Failed, Cancelled };
 const char* to_string(JobState state);
 
+//! What a running job does: reading its files, then the refinement's own stages.
+enum class JobStage { None, Loading, Preparing, Iterating, Finishing };
+const char* to_string(JobStage stage);  //!< "", "loading", "preparing", "iterating", "finishing"
+
 struct JobProgress {
   JobState state = JobState::Queued;
   int iteration = 0;
   std::size_t vertices = 0;
   double sum_g_per_vertex = 0.0;
-  std::string stage;  //!< "loading", "preparing", "iterating", "finishing", or empty
+  JobStage stage = JobStage::None;  //!< None unless Running
 };
 
 struct JobOutcome {
@@ -75,16 +83,21 @@ class Worker {
   //! Asks job \p id to stop: a queued job never starts, a running one stops at its next vertex
   //! block. Returns at once; no effect on a finished job.
   void cancel(JobId id);
-  //! Blocks until job \p id has finished and returns its outcome (the outcome stays available).
+  //! Blocks until job \p id has finished and returns a copy of its outcome (which stays available;
+  //! the copy is made outside the worker's lock).
   JobOutcome wait(JobId id);
-  //! The outcome if job \p id has finished.
+  //! A copy of the outcome if job \p id has finished.
   std::optional<JobOutcome> try_result(JobId id) const;
+  //! Blocks until job \p id has finished, moves its outcome out and forgets the job: its id is
+  //! unknown afterwards (a host that takes every result keeps no finished job in memory).
+  JobOutcome take(JobId id);
 
  private:
   struct Job;
   void run_jobs();
   void run(Job& job);
-  Job& find(JobId id) const;
+  std::shared_ptr<Job> find(JobId id) const;
+  std::shared_ptr<const JobOutcome> finished(const std::shared_ptr<Job>& job);
 
   WorkerOptions options_;
   mutable std::mutex mutex_;

@@ -14,7 +14,11 @@
 #include <unistd.h>
 
 #include "cancel_probe.h"
+#include "engine/error.h"
 #include "engine/worker.h"
+#include "io/mesh_io.h"
+#include "io/scene_io.h"
+#include "stages/synth_scene.h"
 #include "test_support.h"
 
 namespace mvflow {
@@ -146,6 +150,69 @@ TEST_F(WorkerTest, TwoWorkersAtOnceGiveTheSameBits) {
   ASSERT_EQ(x.state, JobState::Succeeded);
   ASSERT_EQ(y.state, JobState::Succeeded);
   EXPECT_EQ(positions_of(x.mesh.topology), positions_of(y.mesh.topology));
+}
+
+// The scene and mesh a host already holds: the photographs' pixels copied into a scene with no
+// file behind it (in_memory_scene), the initial mesh read by the host. Same bits as the job that
+// reads the files, and the job's paths are not read.
+TEST_F(WorkerTest, InMemorySceneAndMeshGiveTheSameBitsAsFiles) {
+  const Scene loaded = io::load_scene(*scene_);
+  ASSERT_TRUE(loaded.mesh_file.has_value());
+  std::vector<View> views;
+  std::vector<Image> images;
+  for (std::size_t i = 0; i < loaded.views.size(); ++i) {
+    views.push_back(loaded.views[i]);
+    images.push_back(loaded.image(i));
+  }
+  JobSpec in_memory = job(6);
+  in_memory.scene = "/nonexistent/scene";
+  in_memory.mesh = "/nonexistent/mesh.ply";
+  in_memory.scene_data = std::make_shared<const Scene>(in_memory_scene(views, images, loaded.bounding_box));
+  in_memory.mesh_data = std::make_shared<const Mesh>(io::load_mesh(*loaded.mesh_file));
+
+  Worker worker(threads(2));
+  const JobOutcome from_memory = worker.take(worker.submit(in_memory));
+  const JobOutcome from_files = worker.take(worker.submit(job(6)));
+  ASSERT_EQ(from_memory.state, JobState::Succeeded) << from_memory.message;
+  ASSERT_EQ(from_files.state, JobState::Succeeded) << from_files.message;
+  EXPECT_EQ(from_memory.summary.iterations.size(), 6u);
+  EXPECT_EQ(positions_of(from_memory.mesh.topology), positions_of(from_files.mesh.topology));
+}
+
+// take() hands the outcome over and forgets the job; wait() and try_result() keep it.
+TEST_F(WorkerTest, TakeMovesTheOutcomeOutAndForgetsTheJob) {
+  Worker worker(threads(2));
+  const auto kept = worker.submit(job(6));
+  const auto taken = worker.submit(job(6));
+  const JobOutcome copy = worker.wait(kept);
+  const JobOutcome outcome = worker.take(taken);
+  ASSERT_EQ(outcome.state, JobState::Succeeded) << outcome.message;
+  EXPECT_EQ(positions_of(outcome.mesh.topology), positions_of(copy.mesh.topology));  // same job, same bits
+  EXPECT_THROW(worker.progress(taken), Error);
+  EXPECT_THROW(worker.try_result(taken), Error);
+  EXPECT_THROW(worker.take(taken), Error);
+  ASSERT_TRUE(worker.try_result(kept).has_value());
+  EXPECT_EQ(worker.try_result(kept)->mesh.n_vertices(), copy.mesh.n_vertices());
+  EXPECT_EQ(worker.progress(kept).state, JobState::Succeeded);
+}
+
+// The stage a host sees while the job runs, and none once it has finished.
+TEST_F(WorkerTest, ProgressStageIsAnEnum) {
+  Worker worker(threads(2));
+  std::atomic<Worker::JobId> id{0};
+  std::vector<JobStage> seen;
+  JobSpec spec = job(6);
+  spec.on_iteration = [&](const IterationReport&) {
+    while (id == 0) std::this_thread::yield();
+    seen.push_back(worker.progress(id).stage);  // the worker thread, outside the worker's lock
+  };
+  id = worker.submit(spec);
+  const JobOutcome outcome = worker.wait(id);
+  ASSERT_EQ(outcome.state, JobState::Succeeded) << outcome.message;
+  ASSERT_EQ(seen.size(), 6u);
+  for (const JobStage stage : seen) EXPECT_EQ(stage, JobStage::Iterating) << to_string(stage);
+  EXPECT_EQ(worker.progress(id).stage, JobStage::None);
+  EXPECT_STREQ(to_string(JobStage::Loading), "loading");
 }
 
 TEST_F(WorkerTest, DestructionWhileRunningCancelsAndJoins) {

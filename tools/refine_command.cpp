@@ -55,7 +55,7 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   const bool live = isatty(fileno(stderr)) != 0;
   control.on_progress = [live](const RefineProgress& p) {
     if (live)
-      std::fprintf(stderr, "\r\033[K%s: iteration %d/%d, %zu vertices, Σg/vertex %.5g", p.stage, p.iteration,
+      std::fprintf(stderr, "\r\033[K%s: iteration %d/%d, %zu vertices, Σg/vertex %.5g", to_string(p.stage), p.iteration,
                    p.max_iterations, p.vertices, p.sum_g_per_vertex);
   };
   log.info("refining {} ({} vertices) with {} views of {}", mesh_file, initial.n_vertices(), scene.size(),
