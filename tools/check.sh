@@ -5,6 +5,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
-bash tools/build.sh -DMVFLOW_BUILD_TESTS=ON
+bash tools/build.sh -DMVFLOW_BUILD_TESTS=ON -DMVFLOW_BUILD_PYTHON=ON
 ctest --test-dir build --output-on-failure --parallel "$(nproc)"
 MVFLOW_FUZZ_SEED=${MVFLOW_FUZZ_SEED:-1} bash tools/fuzz.sh "${MVFLOW_CHECK_FUZZ_SECONDS:-10}"

@@ -47,4 +47,7 @@ void add_hull_command(CLI::App& app, Runner& runner);
 //! `mvflow subdivide MESH --scheme loop|modloop|butterfly [--iterations N] [--sharp-angle DEG] [--faces FILE] -o OUT`
 void add_subdivide_command(CLI::App& app, Runner& runner);
 
+//! Every subcommand above, in the order of `mvflow --help` (the program and the Python module).
+void add_all_commands(CLI::App& app, Runner& runner);
+
 }  // namespace mvflow::cli

@@ -37,17 +37,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
 
   Runner runner;
-  add_info_command(app, runner);
-  add_convert_command(app, runner);
-  add_refine_command(app, runner);
-  add_eval_command(app, runner);
-  add_batch_command(app, runner);
-  add_slice_command(app, runner);
-  add_render_command(app, runner);
-  add_heldout_command(app, runner);
-  add_synth_command(app, runner);
-  add_subdivide_command(app, runner);
-  add_hull_command(app, runner);
+  add_all_commands(app, runner);
 
   try {
     app.parse(argc, argv);

@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
-bash tools/build.sh
+bash tools/build.sh -DMVFLOW_BUILD_PYTHON=ON
 scene=out/default
 mkdir -p out
 build/tools/mvflow synth --preset default -o "$scene"

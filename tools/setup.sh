@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libtbb-dev libopenmesh-dev libopencv-dev libembree-dev
   libspdlog-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest
 )
 
 missing=()
