@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "cancel_probe.h"
-#include "engine/worker.h"
+#include "engine/worker/worker.h"
 #include "test_support.h"
 
 namespace mvflow {

@@ -1,0 +1,147 @@
+#include "engine/worker/worker.h"
+
+#include <atomic>
+
+#include "engine/model/error.h"
+#include "io/mesh_io.h"
+#include "io/scene_io.h"
+
+namespace mvflow {
+
+struct Worker::Job {
+  JobId id = 0;
+  JobSpec spec;
+  std::atomic<bool> cancel{false};
+  JobProgress progress;              // guarded by Worker::mutex_
+  std::optional<JobOutcome> outcome;  // guarded by Worker::mutex_
+};
+
+const char* to_string(JobState state) {
+  switch (state) {
+    case JobState::Queued: return "queued";
+    case JobState::Running: return "running";
+    case JobState::Succeeded: return "succeeded";
+    case JobState::Failed: return "failed";
+    case JobState::Cancelled: return "cancelled";
+  }
+  return "?";
+}
+
+Worker::Worker(WorkerOptions options) : options_(std::move(options)), thread_([this] { run_jobs(); }) {}
+
+Worker::~Worker() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    for (auto& [id, job] : jobs_) job->cancel = true;
+  }
+  changed_.notify_all();
+  thread_.join();
+}
+
+Worker::JobId Worker::submit(JobSpec spec) {
+  auto job = std::make_shared<Job>();
+  job->spec = std::move(spec);
+  {
+    std::lock_guard lock(mutex_);
+    job->id = next_id_++;
+    jobs_.emplace(job->id, job);
+    queue_.push_back(job);
+  }
+  changed_.notify_all();
+  return job->id;
+}
+
+Worker::Job& Worker::find(JobId id) const {
+  const auto found = jobs_.find(id);
+  MVFLOW_CHECK(found != jobs_.end(), "unknown job id " + std::to_string(id));
+  return *found->second;
+}
+
+JobProgress Worker::progress(JobId id) const {
+  std::lock_guard lock(mutex_);
+  return find(id).progress;
+}
+
+void Worker::cancel(JobId id) {
+  std::lock_guard lock(mutex_);
+  find(id).cancel = true;
+}
+
+JobOutcome Worker::wait(JobId id) {
+  std::unique_lock lock(mutex_);
+  Job& job = find(id);
+  changed_.wait(lock, [&] { return job.outcome.has_value(); });
+  return *job.outcome;
+}
+
+std::optional<JobOutcome> Worker::try_result(JobId id) const {
+  std::lock_guard lock(mutex_);
+  return find(id).outcome;
+}
+
+void Worker::run_jobs() {
+  for (;;) {
+    std::shared_ptr<Job> job;
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping, nothing left
+      job = queue_.front();
+      queue_.pop_front();
+      if (job->cancel) {  // cancelled while queued (or the worker is shutting down)
+        job->progress.state = JobState::Cancelled;
+        job->outcome = JobOutcome{JobState::Cancelled, "cancelled before it started", {}, {}};
+        changed_.notify_all();
+        continue;
+      }
+      job->progress.state = JobState::Running;
+      job->progress.stage = "loading";
+    }
+    run(*job);
+    changed_.notify_all();
+  }
+}
+
+void Worker::run(Job& job) {
+  JobOutcome outcome;
+  try {
+    const Scene scene = io::load_scene(job.spec.scene);
+    std::filesystem::path mesh_file = job.spec.mesh;
+    if (mesh_file.empty() && scene.mesh_file) mesh_file = *scene.mesh_file;
+    if (mesh_file.empty()) throw InputError(job.spec.scene, 0, "no initial mesh given and no init.* in the scene");
+    const Mesh initial = io::load_mesh(mesh_file);
+
+    RefineControl control;
+    control.threads = options_.threads;
+    control.logger = options_.logger;
+    control.cancel = &job.cancel;
+    control.on_iteration = job.spec.on_iteration;
+    control.on_block = job.spec.on_block;
+    control.on_progress = [this, &job](const RefineProgress& p) {
+      std::lock_guard lock(mutex_);
+      job.progress.iteration = p.iteration;
+      job.progress.vertices = p.vertices;
+      job.progress.sum_g_per_vertex = p.sum_g_per_vertex;
+      job.progress.stage = p.stage;
+    };
+    RefineResult result = refine_mesh(scene, initial, job.spec.options, control);
+    outcome.summary = std::move(result.summary);
+    outcome.message = outcome.summary.message;
+    outcome.state = outcome.summary.status == RefineStatus::Failed      ? JobState::Failed
+                    : outcome.summary.status == RefineStatus::Cancelled ? JobState::Cancelled
+                                                                         : JobState::Succeeded;
+    if (outcome.state == JobState::Succeeded) outcome.mesh = std::move(result.mesh);
+  } catch (const std::exception& e) {
+    outcome.state = job.cancel ? JobState::Cancelled : JobState::Failed;
+    outcome.message = e.what();
+  }
+  if (options_.logger && outcome.state == JobState::Failed)
+    options_.logger->error("job {}: {}", job.id, outcome.message);
+  std::lock_guard lock(mutex_);
+  job.progress.state = outcome.state;
+  job.progress.stage.clear();
+  job.outcome = std::move(outcome);
+}
+
+}  // namespace mvflow
