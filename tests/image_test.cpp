@@ -1,4 +1,5 @@
-// Images: bilinear sampling against a hand computation, and PNG/JPEG/TIFF reading through OpenCV.
+// Images: bilinear sampling against a hand computation, PNG/JPEG/TIFF reading through OpenCV, and
+// mask files (found by the photograph's stem, size checked against the view's camera).
 
 #include <gtest/gtest.h>
 
@@ -8,6 +9,7 @@
 #include "engine/model/error.h"
 #include "engine/model/image.h"
 #include "io/image_io.h"
+#include "io/mask_files.h"
 #include "test_support.h"
 
 namespace mvflow {
@@ -152,6 +154,74 @@ TEST(ImageIo, FailedWriteLeavesExistingFileIntact) {
   // A folder that does not exist: the temporary file cannot be created, the target is untouched.
   EXPECT_THROW(io::write_png(folder / "missing-folder" / "x.png", ramp_image(2, 2)), Error);
   EXPECT_EQ(test::read_text(file), "previous content");
+}
+
+// A view of \p width × \p height pixels whose photograph is \p image_name.
+View view_of(int width, int height, const std::string& image_name) {
+  Eigen::Matrix3d K;
+  K << 100, 0, width / 2.0, 0, 100, height / 2.0, 0, 0, 1;
+  return View{Camera(K, Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 5), width, height), image_name};
+}
+
+TEST(MaskFiles, FoundByThePhotographsStemInAnyImageFormatAndSizeChecked) {
+  test::ScratchFolder folder;
+  const View view = view_of(6, 4, "photos/dinoSR0003.png");
+  cv::Mat mask(4, 6, CV_8UC1, cv::Scalar(0));
+  mask.at<unsigned char>(1, 2) = 255;
+  ASSERT_TRUE(cv::imwrite((folder / "dinoSR0003.PGM").string(), mask));  // another format, upper case
+  ASSERT_TRUE(cv::imwrite((folder / "dinoSR0004.png").string(), mask));  // another view's
+  test::write_text(folder / "dinoSR0003.txt", "not an image");           // not an image extension
+  const auto file = io::find_mask_file(folder.path(), view, 3);
+  EXPECT_EQ(file, folder / "dinoSR0003.PGM");
+  const Image image = io::read_mask_image(file, view, 3);
+  ASSERT_EQ(image.width(), 6);
+  ASSERT_EQ(image.height(), 4);
+  EXPECT_EQ(image.pixel(2, 1), Eigen::Vector3f(1, 1, 1));
+  EXPECT_EQ(image.pixel(3, 1), Eigen::Vector3f(0, 0, 0));
+
+  // A mask of another size names the file, both sizes and the view.
+  try {
+    io::read_mask_image(folder / "dinoSR0004.png", view_of(8, 4, "dinoSR0004.png"), 4);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("dinoSR0004.png"), std::string::npos) << message;
+    EXPECT_NE(message.find("the mask is 6x4 pixels, but view 4 (dinoSR0004.png) is 8x4"), std::string::npos)
+        << message;
+  }
+}
+
+TEST(MaskFiles, MissingSeveralOrNoFolderAreClearErrors) {
+  test::ScratchFolder folder;
+  const View view = view_of(6, 4, "dinoSR0001.png");
+  try {
+    io::find_mask_file(folder.path(), view, 0);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find((folder / "dinoSR0001.png").string()), std::string::npos) << message;
+    EXPECT_NE(message.find("no mask for view 0 (dinoSR0001.png)"), std::string::npos) << message;
+  }
+  test::write_text(folder / "dinoSR0001.png", "x");
+  test::write_text(folder / "dinoSR0001.jpg", "x");
+  try {
+    io::find_mask_file(folder.path(), view, 0);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("several masks for view 0 (dinoSR0001.png): dinoSR0001.jpg, dinoSR0001.png; keep one"),
+              std::string::npos)
+        << message;
+  }
+  // A mask that is not a decodable image is the image reader's InputError, naming the file.
+  try {
+    io::read_mask_image(folder / "dinoSR0001.png", view, 0);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("dinoSR0001.png"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(io::find_mask_file(folder / "absent", view, 0), IoError);
+  EXPECT_THROW(io::find_mask_file(folder / "dinoSR0001.png", view, 0), IoError);  // a file, not a folder
 }
 
 }  // namespace
