@@ -6,7 +6,7 @@
 #include <fstream>
 #include <system_error>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 
 namespace mvflow::io {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/number_text.h"
 
 namespace mvflow::io {

@@ -3,7 +3,7 @@
 
 #include "io/camera_io.h"
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 
 namespace mvflow::io {
 

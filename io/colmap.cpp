@@ -9,7 +9,7 @@
 #include <map>
 #include <sstream>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/atomic_write.h"
 #include "io/number_text.h"
 #include "io/camera_io.h"

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <map>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/atomic_write.h"
 #include "io/binary_reader.h"
 #include "io/camera_io.h"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/camera_io.h"
 #include "io/number_text.h"
 

@@ -17,7 +17,7 @@
 #include <utility>
 #include <vector>
 
-#include "engine/camera.h"
+#include "engine/model/camera.h"
 
 namespace mvflow::io::colmap {
 

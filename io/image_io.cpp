@@ -10,7 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/atomic_write.h"
 
 namespace mvflow::io {

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <optional>
 
-#include "engine/image.h"
+#include "engine/model/image.h"
 
 namespace mvflow::io {
 

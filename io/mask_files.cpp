@@ -5,7 +5,7 @@
 #include <set>
 #include <vector>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/image_io.h"
 
 namespace mvflow::io {

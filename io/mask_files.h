@@ -1,14 +1,14 @@
 #pragma once
 // Silhouette mask files: one image per view in a folder, matched to the view's photograph by
 // file-name stem (dinoSR0001.png ↔ masks/dinoSR0001.png, .pgm, .jpg, ...). Any image read_image
-// reads (io/image_io.h); a pixel whose largest channel is non-zero is object (stages/silhouette.h turns the
+// reads (io/image_io.h); a pixel whose largest channel is non-zero is object (stages/flow/silhouette.h turns the
 // image into a mask).
 
 #include <filesystem>
 #include <string>
 
-#include "engine/camera.h"
-#include "engine/image.h"
+#include "engine/model/camera.h"
+#include "engine/model/image.h"
 
 namespace mvflow::io {
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cctype>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 
 namespace mvflow::io {
 

@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "engine/mesh.h"
+#include "engine/model/mesh.h"
 
 namespace mvflow::io {
 

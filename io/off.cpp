@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/atomic_write.h"
 #include "io/number_text.h"
 #include "io/mesh_io.h"

@@ -42,7 +42,7 @@
 #include <numbers>
 #include <ostream>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/atomic_write.h"
 #include "io/number_text.h"
 #include "io/camera_io.h"

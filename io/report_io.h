@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/refine_report.h"
+#include "engine/model/refine_report.h"
 
 namespace mvflow::io {
 

@@ -6,7 +6,7 @@
 #include <limits>
 #include <regex>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/image_io.h"
 #include "io/text_reader.h"
 

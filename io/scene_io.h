@@ -13,7 +13,7 @@
 #include <filesystem>
 #include <optional>
 
-#include "engine/scene.h"
+#include "engine/model/scene.h"
 #include "io/camera_io.h"
 
 namespace mvflow::io {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/atomic_write.h"
 #include "io/mesh_io.h"
 

@@ -5,7 +5,7 @@
 #include <charconv>
 #include <cmath>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 
 namespace mvflow::io {
 

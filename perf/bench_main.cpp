@@ -14,14 +14,14 @@
 #include <map>
 #include <optional>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "perf/bench_runs.h"
 #include "perf/bench_scene.h"
 #include "perf/bench_table.h"
 #include "perf/openmvs_case.h"
 #include "perf/peak_memory.h"
 #include "perf/thesis_suite.h"
-#include "stages/photo_kernel.h"
+#include "stages/flow/photo_kernel.h"
 
 namespace mvflow::perf {
 namespace {

@@ -4,8 +4,8 @@
 #include <cstring>
 #include <numeric>
 
-#include "engine/error.h"
-#include "engine/refiner.h"
+#include "engine/model/error.h"
+#include "engine/refine/refiner.h"
 #include "perf/peak_memory.h"
 
 namespace mvflow::perf {

@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <string>
 
-#include "engine/refine_options.h"
-#include "engine/refine_report.h"
+#include "engine/refine/refine_options.h"
+#include "engine/model/refine_report.h"
 #include "perf/bench_scene.h"
 
 namespace mvflow::perf {

@@ -6,9 +6,9 @@
 #include <cstddef>
 #include <string>
 
-#include "engine/mesh.h"
-#include "engine/scene.h"
-#include "stages/synth_scene.h"
+#include "engine/model/mesh.h"
+#include "engine/model/scene.h"
+#include "stages/synth/synth_scene.h"
 
 namespace mvflow::perf {
 

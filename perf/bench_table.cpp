@@ -7,7 +7,7 @@
 #include <fstream>
 #include <thread>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 
 namespace mvflow::perf {
 

@@ -6,8 +6,8 @@
 #include <Eigen/Geometry>
 #include <random>
 
-#include "engine/camera.h"
-#include "engine/image.h"
+#include "engine/model/camera.h"
+#include "engine/model/image.h"
 
 namespace {
 

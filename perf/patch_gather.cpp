@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "stages/photo_consistency.h"
-#include "stages/photo_kernel.h"
+#include "stages/flow/photo_consistency.h"
+#include "stages/flow/photo_kernel.h"
 
 namespace mvflow::perf {
 
@@ -36,7 +36,7 @@ std::vector<PatchBlock> gradient_patch_blocks(const std::vector<Eigen::Vector3d>
 // The 8-lane vector type is passed only to an always-inlined function of the same build.
 #pragma GCC diagnostic ignored "-Wpsabi"
 
-// The same loop compiled for each build of the photo kernel (stages/photo_kernel.cpp), so that
+// The same loop compiled for each build of the photo kernel (stages/flow/photo_kernel.cpp), so that
 // each build's reads are measured with that build's loads.
 #define MVFLOW_GATHER_BODY                                                                          \
   using Floats = float __attribute__((vector_size(32)));                                            \

@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "stages/photo_views.h"
+#include "stages/flow/photo_views.h"
 
 namespace mvflow::perf {
 

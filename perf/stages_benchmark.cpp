@@ -12,23 +12,23 @@
 #include <cmath>
 #include <numbers>
 
-#include "engine/iteration.h"
-#include "engine/iteration_graph.h"
-#include "engine/mesh_stats.h"
-#include "engine/surface_query.h"
+#include "engine/refine/iteration.h"
+#include "engine/refine/iteration_graph.h"
+#include "engine/model/mesh_stats.h"
+#include "engine/model/surface_query.h"
 #include "perf/bench_scene.h"
 #include "perf/patch_gather.h"
-#include "stages/adaptive_refinement.h"
-#include "stages/commit.h"
-#include "stages/curvature.h"
-#include "stages/normals.h"
-#include "stages/photo_consistency.h"
-#include "stages/photo_gradient.h"
-#include "stages/photo_kernel.h"
-#include "stages/regularization.h"
-#include "stages/smoothing.h"
-#include "stages/speed.h"
-#include "stages/visibility.h"
+#include "stages/topology/adaptive_refinement.h"
+#include "stages/flow/commit.h"
+#include "stages/flow/curvature.h"
+#include "stages/flow/normals.h"
+#include "stages/flow/photo_consistency.h"
+#include "stages/flow/photo_gradient.h"
+#include "stages/flow/photo_kernel.h"
+#include "stages/flow/regularization.h"
+#include "stages/flow/smoothing.h"
+#include "stages/flow/speed.h"
+#include "stages/flow/visibility.h"
 
 namespace mvflow {
 namespace {

@@ -4,8 +4,8 @@
 #include <iostream>
 #include <optional>
 
-#include "engine/error.h"
-#include "engine/refiner.h"
+#include "engine/model/error.h"
+#include "engine/refine/refiner.h"
 #include "perf/bench_runs.h"
 #include "perf/bench_scene.h"
 #include "perf/peak_memory.h"

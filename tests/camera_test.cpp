@@ -5,8 +5,8 @@
 
 #include <Eigen/Geometry>
 
-#include "engine/camera.h"
-#include "engine/error.h"
+#include "engine/model/camera.h"
+#include "engine/model/error.h"
 
 namespace mvflow {
 namespace {

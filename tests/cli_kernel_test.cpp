@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "stages/photo_kernel.h"
+#include "stages/flow/photo_kernel.h"
 #include "test_support.h"
 
 namespace mvflow {

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/camera.h"
-#include "engine/error.h"
+#include "engine/model/camera.h"
+#include "engine/model/error.h"
 #include "io/camera_io.h"
 #include "io/scene_io.h"
 #include "colmap_reference.h"

@@ -1,7 +1,7 @@
 // The embedding example of the README (kept identical to it by readme_test.cpp).
 #include <cstdio>
 
-#include "engine/worker.h"
+#include "engine/worker/worker.h"
 
 int main(int argc, char** argv) {
   if (argc < 2) return 2;

@@ -8,9 +8,9 @@
 #include <cstdio>
 
 #include "cancel_probe.h"
-#include "engine/refiner.h"
-#include "stages/evaluation.h"
-#include "stages/synth_scene.h"
+#include "engine/refine/refiner.h"
+#include "stages/eval/evaluation.h"
+#include "stages/synth/synth_scene.h"
 
 namespace mvflow {
 namespace {

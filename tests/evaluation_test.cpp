@@ -6,9 +6,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "engine/error.h"
-#include "engine/primitives.h"
-#include "stages/evaluation.h"
+#include "engine/model/error.h"
+#include "engine/model/primitives.h"
+#include "stages/eval/evaluation.h"
 
 namespace mvflow {
 namespace {

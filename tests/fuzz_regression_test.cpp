@@ -12,7 +12,7 @@
 #include <new>
 #include <string>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"

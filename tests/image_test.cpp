@@ -5,8 +5,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "engine/error.h"
-#include "engine/image.h"
+#include "engine/model/error.h"
+#include "engine/model/image.h"
 #include "io/image_io.h"
 #include "test_support.h"
 

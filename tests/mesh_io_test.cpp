@@ -17,7 +17,7 @@
 #include <set>
 #include <sstream>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 
 namespace mvflow::io {
 namespace {

@@ -8,9 +8,9 @@
 #include <thread>
 #include <vector>
 
-#include "engine/error.h"
-#include "engine/mesh_stats.h"
-#include "engine/vertex_fields.h"
+#include "engine/model/error.h"
+#include "engine/model/mesh_stats.h"
+#include "engine/model/vertex_fields.h"
 #include "io/atomic_write.h"
 #include "io/text_reader.h"
 #include "test_support.h"

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/image_io.h"
 #include "io/scene_io.h"
 #include "test_support.h"

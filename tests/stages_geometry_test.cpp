@@ -7,10 +7,10 @@
 #include <cstdio>
 #include <numbers>
 
-#include "engine/error.h"
-#include "engine/vertex_fields.h"
-#include "stages/curvature.h"
-#include "stages/normals.h"
+#include "engine/model/error.h"
+#include "engine/model/vertex_fields.h"
+#include "stages/flow/curvature.h"
+#include "stages/flow/normals.h"
 #include "stages_meshes.h"
 
 namespace mvflow {

@@ -11,10 +11,10 @@
 
 #include <tbb/task_arena.h>
 
-#include "engine/error.h"
-#include "engine/primitives.h"
-#include "stages/heldout_error.h"
-#include "stages/synth_scene.h"
+#include "engine/model/error.h"
+#include "engine/model/primitives.h"
+#include "stages/eval/heldout_error.h"
+#include "stages/synth/synth_scene.h"
 
 namespace mvflow {
 namespace {

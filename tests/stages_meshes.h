@@ -1,7 +1,7 @@
 #pragma once
 // Meshes and measurements for the stage tests: spheres (exact, noisy, tangentially jittered),
 // flat grids, and the spread of a mesh's edge lengths. The icosphere itself is
-// engine/primitives.h's make_icosphere (subdivided icosahedron projected onto the sphere), so
+// engine/model/primitives.h's make_icosphere (subdivided icosahedron projected onto the sphere), so
 // the tests exercise the same generator the synthetic scenes use.
 
 #include <cmath>
@@ -12,9 +12,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "engine/mesh.h"
-#include "engine/primitives.h"
-#include "engine/vertex_fields.h"
+#include "engine/model/mesh.h"
+#include "engine/model/primitives.h"
+#include "engine/model/vertex_fields.h"
 
 namespace mvflow::test {
 

@@ -1,5 +1,5 @@
-// The photo-consistency options for real photographs (stages/photo_robust.h, view selection in
-// stages/visibility.h) and the speed of unobserved vertices (stages/unobserved_speed.h), each
+// The photo-consistency options for real photographs (stages/flow/photo_robust.h, view selection in
+// stages/flow/visibility.h) and the speed of unobserved vertices (stages/flow/unobserved_speed.h), each
 // against an analytic case or a brute-force computation written here.
 
 #include <gtest/gtest.h>
@@ -11,14 +11,14 @@
 #include <numbers>
 #include <random>
 
-#include "engine/primitives.h"
-#include "engine/surface_query.h"
-#include "stages/image_pyramid.h"
-#include "stages/normals.h"
-#include "stages/photo_robust.h"
-#include "stages/synth_cameras.h"
-#include "stages/unobserved_speed.h"
-#include "stages/visibility.h"
+#include "engine/model/primitives.h"
+#include "engine/model/surface_query.h"
+#include "stages/flow/image_pyramid.h"
+#include "stages/flow/normals.h"
+#include "stages/flow/photo_robust.h"
+#include "stages/synth/synth_cameras.h"
+#include "stages/flow/unobserved_speed.h"
+#include "stages/flow/visibility.h"
 #include "stages_meshes.h"
 
 namespace mvflow {

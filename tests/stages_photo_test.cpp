@@ -11,14 +11,14 @@
 #include <random>
 #include <ranges>
 
-#include "engine/primitives.h"
-#include "engine/surface_query.h"
-#include "stages/normals.h"
-#include "stages/photo_consistency.h"
-#include "stages/photo_gradient.h"
-#include "stages/photo_kernel.h"
-#include "stages/synth_scene.h"
-#include "stages/visibility.h"
+#include "engine/model/primitives.h"
+#include "engine/model/surface_query.h"
+#include "stages/flow/normals.h"
+#include "stages/flow/photo_consistency.h"
+#include "stages/flow/photo_gradient.h"
+#include "stages/flow/photo_kernel.h"
+#include "stages/synth/synth_scene.h"
+#include "stages/flow/visibility.h"
 #include "test_support.h"
 
 namespace mvflow {

@@ -11,11 +11,11 @@
 #include <set>
 #include <vector>
 
-#include "engine/error.h"
-#include "engine/mesh_stats.h"
-#include "stages/adaptive_refinement.h"
-#include "stages/curvature.h"
-#include "stages/normals.h"
+#include "engine/model/error.h"
+#include "engine/model/mesh_stats.h"
+#include "stages/topology/adaptive_refinement.h"
+#include "stages/flow/curvature.h"
+#include "stages/flow/normals.h"
 #include "stages_meshes.h"
 #include "test_support.h"
 

@@ -10,10 +10,10 @@
 #include <numbers>
 #include <vector>
 
-#include "engine/error.h"
-#include "engine/mesh_stats.h"
-#include "stages/remeshing.h"
-#include "stages/self_intersections.h"  // the input check only
+#include "engine/model/error.h"
+#include "engine/model/mesh_stats.h"
+#include "stages/topology/remeshing.h"
+#include "stages/topology/self_intersections.h"  // the input check only
 #include "stages_meshes.h"
 #include "test_support.h"
 
@@ -190,7 +190,7 @@ TEST_F(WarpedSphere, OnePassLeavesFewEdgesOutsideTheBoundsAndASecondPassFewer) {
               second.total, 100 * second.outside_fraction(), first.shortest, first.longest);
   std::printf("[measured] second pass: splits %zu, collapses %zu, rejected %zu\n", again.splits, again.collapses,
               again.rejected_collapses);
-  // One pass cannot guarantee the bounds (stages/remeshing.h): the midpoint-to-corner edges of a
+  // One pass cannot guarantee the bounds (stages/topology/remeshing.h): the midpoint-to-corner edges of a
   // split may still exceed b_u and rejected or revisited collapses leave edges below b_l.
   // Measured: 52.8 % outside before, 5.5 % (672 long, 19 short) after one pass, 0.08 % after two.
   EXPECT_LT(first.outside_fraction(), 0.07);

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "engine/error.h"
-#include "engine/primitives.h"
-#include "stages/mesh_render.h"
+#include "engine/model/error.h"
+#include "engine/model/primitives.h"
+#include "stages/eval/mesh_render.h"
 
 namespace mvflow {
 namespace {

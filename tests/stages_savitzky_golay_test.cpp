@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "engine/error.h"
-#include "stages/savitzky_golay.h"
+#include "engine/model/error.h"
+#include "stages/flow/savitzky_golay.h"
 
 namespace mvflow {
 namespace {

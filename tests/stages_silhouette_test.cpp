@@ -3,10 +3,10 @@
 
 #include <random>
 
-#include "engine/camera.h"
-#include "engine/error.h"
-#include "stages/silhouette.h"
-#include "stages/silhouette_constraint.h"
+#include "engine/model/camera.h"
+#include "engine/model/error.h"
+#include "stages/flow/silhouette.h"
+#include "stages/flow/silhouette_constraint.h"
 
 namespace mvflow {
 namespace {

@@ -8,10 +8,10 @@
 #include <cstdio>
 #include <numbers>
 
-#include "engine/primitives.h"
-#include "engine/surface_query.h"
-#include "stages/photo_slice.h"
-#include "stages/synth_scene.h"
+#include "engine/model/primitives.h"
+#include "engine/model/surface_query.h"
+#include "stages/eval/photo_slice.h"
+#include "stages/synth/synth_scene.h"
 
 namespace mvflow {
 namespace {

@@ -6,11 +6,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "engine/error.h"
-#include "stages/commit.h"
-#include "stages/normals.h"
-#include "stages/regularization.h"
-#include "stages/smoothing.h"
+#include "engine/model/error.h"
+#include "stages/flow/commit.h"
+#include "stages/flow/normals.h"
+#include "stages/flow/regularization.h"
+#include "stages/flow/smoothing.h"
 #include "stages_meshes.h"
 
 namespace mvflow {

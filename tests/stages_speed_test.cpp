@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "engine/error.h"
-#include "stages/speed.h"
+#include "engine/model/error.h"
+#include "stages/flow/speed.h"
 #include "stages_meshes.h"
 
 namespace mvflow {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "engine/error.h"
-#include "stages/stopping.h"
+#include "engine/model/error.h"
+#include "stages/flow/stopping.h"
 
 namespace mvflow {
 namespace {

@@ -11,10 +11,10 @@
 #include <cstring>
 #include <set>
 
-#include "engine/error.h"
-#include "engine/mesh_stats.h"
+#include "engine/model/error.h"
+#include "engine/model/mesh_stats.h"
 #include "io/mesh_io.h"
-#include "stages/subdivision.h"
+#include "stages/topology/subdivision.h"
 #include "stages_meshes.h"
 #include "test_support.h"
 

@@ -1,4 +1,4 @@
-// Unobserved vertices following the observed surface (stages/unobserved_displacement.h), against
+// Unobserved vertices following the observed surface (stages/flow/unobserved_displacement.h), against
 // surfaces whose answer is known: a constant offset, a linear ramp, a sphere.
 
 #include <gtest/gtest.h>
@@ -7,9 +7,9 @@
 #include <numbers>
 #include <vector>
 
-#include "engine/error.h"
-#include "stages/synth_cameras.h"
-#include "stages/unobserved_displacement.h"
+#include "engine/model/error.h"
+#include "stages/synth/synth_cameras.h"
+#include "stages/flow/unobserved_displacement.h"
 #include "stages_meshes.h"
 
 namespace mvflow {

@@ -13,9 +13,9 @@
 #include <utility>
 #include <vector>
 
-#include "engine/error.h"
-#include "stages/self_intersections.h"
-#include "stages/untangling.h"
+#include "engine/model/error.h"
+#include "stages/topology/self_intersections.h"
+#include "stages/topology/untangling.h"
 #include "stages_meshes.h"
 
 namespace mvflow {

@@ -7,8 +7,8 @@
 #include <Eigen/Geometry>
 #include <random>
 
-#include "engine/error.h"
-#include "engine/surface_query.h"
+#include "engine/model/error.h"
+#include "engine/model/surface_query.h"
 #include "test_support.h"
 
 namespace mvflow {

@@ -11,12 +11,12 @@
 
 #include <tbb/task_arena.h>
 
-#include "engine/mesh_stats.h"
-#include "engine/surface_query.h"
+#include "engine/model/mesh_stats.h"
+#include "engine/model/surface_query.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
-#include "stages/synth_scene.h"
+#include "stages/synth/synth_scene.h"
 #include "test_support.h"
 
 namespace mvflow {

@@ -16,7 +16,7 @@
 #include <numbers>
 #include <string>
 
-#include "engine/mesh.h"
+#include "engine/model/mesh.h"
 
 namespace mvflow::test {
 

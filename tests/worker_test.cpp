@@ -14,11 +14,11 @@
 #include <unistd.h>
 
 #include "cancel_probe.h"
-#include "engine/error.h"
-#include "engine/worker.h"
+#include "engine/model/error.h"
+#include "engine/worker/worker.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
-#include "stages/synth_scene.h"
+#include "stages/synth/synth_scene.h"
 #include "test_support.h"
 
 namespace mvflow {

@@ -7,8 +7,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "engine/error.h"
-#include "engine/refiner.h"
+#include "engine/model/error.h"
+#include "engine/refine/refiner.h"
 #include "io/atomic_write.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"

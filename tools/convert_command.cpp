@@ -2,7 +2,7 @@
 
 #include <filesystem>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"

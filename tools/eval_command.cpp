@@ -5,7 +5,7 @@
 
 #include "io/atomic_write.h"
 #include "io/mesh_io.h"
-#include "stages/evaluation.h"
+#include "stages/eval/evaluation.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include <tbb/task_arena.h>
 
 #include "io/atomic_write.h"
@@ -16,8 +16,8 @@
 #include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
-#include "stages/heldout_error.h"
-#include "stages/silhouette.h"
+#include "stages/eval/heldout_error.h"
+#include "stages/flow/silhouette.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {

@@ -10,17 +10,17 @@
 #include <fmt/format.h>
 #include <vector>
 
-#include "engine/error.h"
-#include "engine/mesh_stats.h"
+#include "engine/model/error.h"
+#include "engine/model/mesh_stats.h"
 #include "io/atomic_write.h"
 #include "io/image_io.h"
 #include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
-#include "stages/hull_mesh.h"
-#include "stages/mesh_cleanup.h"
-#include "stages/silhouette.h"
-#include "stages/silhouette_holes.h"
+#include "stages/hull/hull_mesh.h"
+#include "stages/hull/mesh_cleanup.h"
+#include "stages/flow/silhouette.h"
+#include "stages/hull/silhouette_holes.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "engine/error.h"
-#include "engine/mesh_stats.h"
+#include "engine/model/error.h"
+#include "engine/model/mesh_stats.h"
 #include "io/atomic_write.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"

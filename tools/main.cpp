@@ -8,9 +8,9 @@
 #include <iostream>
 #include <string>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/image_io.h"
-#include "stages/photo_kernel.h"
+#include "stages/flow/photo_kernel.h"
 #include "tools/commands.h"
 
 #ifndef MVFLOW_VERSION

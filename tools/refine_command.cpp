@@ -6,13 +6,13 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "engine/error.h"
-#include "engine/refiner.h"
+#include "engine/model/error.h"
+#include "engine/refine/refiner.h"
 #include "io/atomic_write.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
-#include "stages/photo_kernel.h"
+#include "stages/flow/photo_kernel.h"
 #include "tools/commands.h"
 #include "tools/interrupt.h"
 #include "tools/refine_option_table.h"

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/refine_options.h"
+#include "engine/refine/refine_options.h"
 
 namespace mvflow::cli {
 

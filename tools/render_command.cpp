@@ -2,11 +2,11 @@
 
 #include <fmt/format.h>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
-#include "stages/mesh_render.h"
+#include "stages/eval/mesh_render.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {

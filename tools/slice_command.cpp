@@ -5,11 +5,11 @@
 #include <cmath>
 #include <fmt/format.h>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
-#include "stages/photo_slice.h"
+#include "stages/eval/photo_slice.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {

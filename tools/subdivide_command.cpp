@@ -3,10 +3,10 @@
 
 #include <map>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/mesh_io.h"
 #include "io/text_reader.h"
-#include "stages/subdivision.h"
+#include "stages/topology/subdivision.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {

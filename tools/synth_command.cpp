@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include <tbb/task_arena.h>
 
 #include "io/atomic_write.h"
@@ -18,7 +18,7 @@
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/number_text.h"
-#include "stages/synth_scene.h"
+#include "stages/synth/synth_scene.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {

@@ -13,7 +13,7 @@
 #include <string_view>
 #include <unistd.h>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 
 namespace mvflow::fuzz {
 

@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "engine/error.h"
+#include "engine/model/error.h"
 #include "io/camera_io.h"
 #include "io/mesh_io.h"
 #include "tests/fuzz/sample_views.h"

@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 #include <vector>
 
-#include "engine/camera.h"
+#include "engine/model/camera.h"
 
 namespace mvflow::fuzz {
 

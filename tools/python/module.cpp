@@ -24,13 +24,13 @@
 
 #include <unistd.h>
 
-#include "engine/error.h"
-#include "engine/refiner.h"
-#include "engine/worker.h"
+#include "engine/model/error.h"
+#include "engine/refine/refiner.h"
+#include "engine/worker/worker.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
-#include "stages/evaluation.h"
-#include "stages/photo_kernel.h"
+#include "stages/eval/evaluation.h"
+#include "stages/flow/photo_kernel.h"
 #include "tools/commands.h"
 #include "tools/refine_option_table.h"
 

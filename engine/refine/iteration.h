@@ -1,0 +1,108 @@
+#pragma once
+// One deformation iteration (SPEC §3–§6) cut into per-block kernels. The flow graph
+// (engine/refine/iteration_graph.h) and the sequential path call exactly these functions, so both give
+// the same bits: every kernel writes only its own block's entries, and sums over blocks are
+// combined in block order.
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/model/mesh.h"
+#include "engine/model/mesh_stats.h"
+#include "engine/refine/refine_options.h"
+#include "engine/model/refine_report.h"
+#include "engine/model/surface_query.h"
+#include "engine/model/vertex_fields.h"
+#include "stages/flow/photo_gradient.h"
+#include "stages/flow/photo_views.h"
+#include "stages/flow/silhouette_constraint.h"
+#include "stages/flow/speed.h"
+
+namespace mvflow {
+
+//! What the nodes of one iteration share. The mesh's positions change only in the move and
+//! commit kernels, and the Embree scene only in refit(), each ordered by the graph's edges.
+struct IterationData {
+  IterationData(TriMesh& mesh, const std::vector<PhotoView>& views, const RefineOptions& options,
+                const std::atomic<bool>* cancel);
+
+  TriMesh& mesh;
+  const std::vector<PhotoView>& views;
+  const RefineOptions& options;
+  const std::atomic<bool>* cancel;
+  //! Called after each per-block kernel did its work (RefineControl::on_block); may be empty.
+  std::function<void(std::size_t block)> on_block;
+  PhotoGradientStage photo;
+  const SilhouetteConstraint* inside = nullptr;  //!< keeps the surface in the visual hull when set
+
+  std::unique_ptr<SurfaceQuery> surface;  //!< rebuilt when the topology changes, refitted otherwise
+  VertexFields fields;
+  std::vector<IndexRange> blocks;
+  std::vector<BlockPartial> partials;            //!< one per block
+  std::vector<Eigen::Vector3d> new_positions;    //!< Jacobi buffer of smoothing / regularization
+  std::vector<double> moved;                     //!< length of each vertex's move this iteration
+  //! For the unobserved-speed fill: the positions at the start of the last iteration (empty
+  //! until one ran on this topology), then each vertex's whole step in it (refit()).
+  std::vector<Eigen::Vector3d> iteration_start, last_step;
+  double last_time_step = 0.0;
+  std::vector<std::array<double, kStageCount>> block_seconds;  //!< per block, per stage
+
+  // Set before the iteration runs (set_edge_lengths).
+  double shortest_edge = 0.0;
+  double mean_edge = 0.0;
+  double sample_spacing = 0.0;  //!< Δx of the gradient's samples, from the shortest edge
+  bool refit_needed = false;
+  // Set by the CFL kernel.
+  BlockPartial total;
+  double time_step = 0.0;
+  MoveLimit move_limit;      //!< the CFL bound on one vertex's move
+  double step_scale = 1.0;   //!< the fraction of the CFL step taken (step control), reset with the topology
+  double previous_g_per_vertex = 0.0;  //!< Σg/vertex of the previous iteration on this topology
+  //! Set by measure_moves(): the median over the moving vertices of their move divided by the
+  //! edge the CFL bound used for them (their own shortest edge, or e_min with the global bound).
+  double median_move = 0.0;
+  std::size_t moving = 0;
+  double serial_seconds[kStageCount] = {};
+
+  //! Sizes everything for the mesh's current topology (new blocks, fields, Embree scene).
+  void reset_topology();
+  //! True once the cancel flag has been seen, even if the host clears it again: an iteration
+  //! whose kernels skipped blocks never counts as done (see stopped).
+  bool cancelled() {
+    if (stopped.load(std::memory_order_relaxed)) return true;
+    if (!cancel || !cancel->load(std::memory_order_relaxed)) return false;
+    stopped.store(true, std::memory_order_relaxed);
+    return true;
+  }
+  std::atomic<bool> stopped{false};  //!< a kernel saw the cancel flag (set by cancelled())
+
+  // The kernels. `block` indexes `blocks`.
+  void set_edge_lengths(const EdgeLengths& edges);  //!< e_min, the mean edge and Δx, before an iteration
+  void refit();                        //!< serial: Embree refit to the current positions
+  void geometry(std::size_t block);    //!< N and H
+  void visibility(std::size_t block);  //!< visible views
+  //! g, ∇g (3k+1 samples), F, and the block's partial; with the graph engine the block's
+  //! vertices are shared among idle threads (nested parallel_for), never with the sequential one.
+  void photo_speed(std::size_t block);
+  void cfl();                          //!< serial: combine partials in block order, Δt, median move
+  void adapt_step_scale();             //!< part of cfl(): the step control
+  void fill_speeds();                  //!< part of cfl(): speeds of unobserved vertices
+  void move(std::size_t block);        //!< P ← P + Δt·F
+  void measure_moves();                //!< serial, after the iteration: median_move
+  void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
+  void inflate(std::size_t block);     //!< new position of Taubin's second step (taubin_pass_band > 0)
+  void regularize(std::size_t block);  //!< normals at the current positions, then regularization
+  void commit(std::size_t block);      //!< new positions into the mesh
+};
+
+//! Runs one iteration's kernels in a plain loop on the calling thread, in the order the graph's
+//! edges impose: the reference path for determinism tests and benchmarks.
+void run_iteration_sequential(IterationData& data);
+
+}  // namespace mvflow

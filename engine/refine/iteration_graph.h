@@ -1,0 +1,50 @@
+#pragma once
+// One deformation iteration as a oneTBB flow graph (SPEC §6): a dependence graph of
+// continue_nodes over the shared IterationData (the shape of oneTBB's cholesky example).
+//
+//   refit ─┬─ geometry₀ → visibility₀ → photo₀ ─┐
+//          ├─ geometry₁ → visibility₁ → photo₁ ─┤
+//          └─ …                                  ┴─ cfl ─┬─ move₀ ─┐
+//                                                        └─ move₁ ─┴─ moved ─ smooth_b … ─ commit_b … ─ regularize_b … ─ commit_b … ─ done
+//
+// A block's photo node starts as soon as its own geometry and visibility are done; the only
+// global barrier before the CFL reduction is the refit. Built once per topology (the block
+// count and ranges are baked into the nodes); run many times.
+
+#include <memory>
+#include <vector>
+
+#include <oneapi/tbb/flow_graph.h>
+
+#include "engine/refine/iteration.h"
+
+namespace mvflow {
+
+class IterationGraph {
+ public:
+  //! Builds the nodes for data.blocks. The graph attaches to the task arena that is current
+  //! where it is constructed, so construct it inside the engine's arena.
+  explicit IterationGraph(IterationData& data);
+  IterationGraph(const IterationGraph&) = delete;
+  IterationGraph& operator=(const IterationGraph&) = delete;
+
+  //! Runs one iteration and waits for it. Rethrows the first exception a node threw (after
+  //! cancelling the rest); the graph is reset and can run again either way. Once the cancel flag
+  //! is set the rest of the graph drains: every kernel checks the flag and returns at once (the
+  //! whole graph with empty bodies takes 0.06 ms at 10k vertices, perf/README.md), so the flag
+  //! needs no cancellation of the graph's task_group_context.
+  void run();
+  std::size_t n_blocks() const { return n_blocks_; }
+
+ private:
+  using Node = oneapi::tbb::flow::continue_node<oneapi::tbb::flow::continue_msg>;
+  Node* add(std::function<void()> body);
+  Node* barrier();
+
+  oneapi::tbb::flow::graph graph_;  // declared before the nodes: it must outlive them
+  std::vector<std::unique_ptr<Node>> nodes_;
+  Node* start_ = nullptr;
+  std::size_t n_blocks_ = 0;
+};
+
+}  // namespace mvflow

@@ -1,0 +1,110 @@
+#pragma once
+// Every parameter of a refinement, one nested Options struct per stage (their defaults and
+// ranges are documented where each stage is declared), plus presets as functions.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "stages/topology/adaptive_refinement.h"
+#include "stages/flow/curvature.h"
+#include "stages/flow/photo_gradient.h"
+#include "stages/flow/regularization.h"
+#include "stages/topology/remeshing.h"
+#include "stages/flow/silhouette.h"
+#include "stages/flow/smoothing.h"
+#include "stages/flow/speed.h"
+#include "stages/flow/stopping.h"
+#include "stages/flow/unobserved_displacement.h"
+#include "stages/flow/unobserved_speed.h"
+#include "stages/topology/untangling.h"
+#include "stages/flow/visibility.h"
+
+namespace mvflow {
+
+//! How an iteration's stages are scheduled. Both give bit-identical results.
+enum class EngineKind {
+  Graph,      //!< one oneTBB flow graph per iteration, nodes per vertex block (SPEC §6)
+  Sequential  //!< the same per-block stage functions in a plain loop on the calling thread
+};
+
+//! When adaptive refinement runs.
+enum class RefinementSchedule {
+  EveryIteration,  //!< before every iteration but the first (thesis §5.3.4)
+  //! Coarse to fine: when the flow has converged at the current resolution (the Converged or
+  //! StepSmall rule fires), then the stopping rules start afresh; the run ends (with that rule's
+  //! status) when they fire and refinement adds nothing or is declined as too small
+  //! (AdaptiveRefinementOptions::min_growth). README, "Defaults and differences".
+  AtConvergence,
+};
+
+struct RefineOptions {
+  CurvatureOptions curvature;
+  VisibilityOptions visibility;
+  PhotoGradientOptions photo;          //!< Savitzky–Golay window and the photo-consistency patch
+  SpeedOptions speed;                  //!< balloon velocity v
+  //! Whether vertices without g or ∇g move with their observed neighbours (default: no).
+  UnobservedSpeedOptions unobserved;
+  //! Whether the poorly observed vertices take the observed surface's displacement when the
+  //! flow has converged at a resolution and at the end (default: yes; thesis preset: no).
+  UnobservedDisplacementOptions unobserved_displacement;
+  //! Δt = cfl·(e/2)/(√3·|F|_q), e the mean edge (local_step) or e_min (SPEC §4; thesis 1)
+  double cfl = 1.0;
+  //! q, the quantile of |F| over the moving vertices that sets Δt; in (0, 1]. 1 = max|F|, the
+  //! thesis's CFL rule. Below 1, vertices faster than |F|_q move only their CFL distance along F
+  //! (cfl/(2√3) of their own shortest edge with local_step, of e_min without).
+  double speed_quantile = 0.9;
+  //! Local CFL: Δt uses the mean edge instead of the shortest, and each vertex moves at most
+  //! cfl/(2√3) of its own shortest edge, so one short edge slows only its own vertices. false:
+  //! the thesis's global rule (every vertex moves at most cfl·e_min/(2√3)).
+  bool local_step = true;
+  //! Step control: when an iteration finds Σg/vertex higher than the one before (on the same
+  //! mesh), the last step overshot, so the steps are halved; after a decrease they grow back by
+  //! 1.25× up to the CFL step. false: always the CFL step (the thesis).
+  bool step_control = false;
+  SmoothingOptions smoothing;
+  RegularizationOptions regularization;
+  StoppingOptions stopping;
+  bool global_remeshing = true;        //!< split/collapse once before the flow (SPEC §5)
+  RemeshingOptions remeshing;
+  bool adaptive_refinement = true;     //!< quadrisect high-curvature regions between iterations
+  AdaptiveRefinementOptions adaptive;
+
+  //! Coarse-to-fine images: the flow starts on the photographs halved this many times
+  //! (stages/flow/image_pyramid.h) and moves one level finer each time it has settled; adaptive
+  //! refinement (with either schedule) waits for the full resolution; 0 = full resolution
+  //! throughout (the thesis). 0..4.
+  int image_levels = 0;
+
+  RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration
+  //! Folds removed where the flow has settled: before each coarse-to-fine refinement (then the
+  //! curvature is recomputed, so that the marks do not follow a removed fold) and at the end of
+  //! the run (with either schedule). max_rounds 0 (the thesis preset) disables.
+  UntanglingOptions untangling;
+  //! Vertices per block (one graph node per block and stage). 128: on the default scene (800
+  //! vertices) 1024 left one block and no speed-up from a second thread; at 10k vertices 64, 128
+  //! and 512 gave the same time (README, "Performance").
+  std::size_t block_size = 128;
+  EngineKind engine = EngineKind::Graph;
+  std::vector<int> excluded_views;     //!< 0-based view indices the refinement must not use
+  //! Keep the surface inside the visual hull of the used views' silhouettes (thresholded from
+  //! their images; SilhouetteConstraint). Off by default and in the thesis: it needs photographs
+  //! whose background separates from the object.
+  bool keep_inside_silhouettes = false;
+  //! How the silhouettes are thresholded; 0.19 (Middlebury) with a 3-pixel dilation so that
+  //! calibration error does not cut into the object.
+  SilhouetteOptions silhouettes{.threshold = 0.19, .dilate = 3};
+
+  //! \throw InputError naming the first option out of range.
+  void check() const;
+};
+
+//! SPEC's defaults (this struct's initializers).
+RefineOptions default_preset();
+//! Exactly the thesis's parameters (appendix B.7, SPEC §9): grazing views up to 90°, the
+//! barycentric curvature area, ε = 0.3 %.
+RefineOptions thesis_preset();
+//! "default" or "thesis". \throw InputError otherwise.
+RefineOptions preset(const std::string& name);
+
+}  // namespace mvflow

@@ -1,0 +1,410 @@
+#include "engine/refine/refiner.h"
+
+#include <oneapi/tbb/info.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <span>
+
+#include "engine/model/error.h"
+#include "engine/refine/iteration.h"
+#include "engine/refine/iteration_graph.h"
+#include "engine/model/mesh_stats.h"
+#include "stages/topology/adaptive_refinement.h"
+#include "stages/flow/curvature.h"
+#include "stages/flow/image_pyramid.h"
+#include "stages/flow/normals.h"
+#include "stages/flow/photo_consistency.h"
+#include "stages/flow/photo_robust.h"
+#include "stages/flow/regularization.h"
+#include "stages/topology/remeshing.h"
+#include "stages/topology/self_intersections.h"
+#include "stages/flow/silhouette_constraint.h"
+#include "stages/flow/smoothing.h"
+#include "stages/flow/unobserved_displacement.h"
+#include "stages/topology/untangling.h"
+#include "stages/flow/visibility.h"
+
+namespace mvflow {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The views the refinement may use, in scene order without the excluded ones.
+std::vector<PhotoView> usable_views(const Scene& scene, const std::vector<int>& excluded) {
+  std::vector<PhotoView> all = make_photo_views(scene);
+  std::vector<PhotoView> kept;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) != excluded.end()) continue;
+    kept.push_back(all[i]);
+  }
+  for (int view : excluded)
+    if (view >= static_cast<int>(all.size()))
+      throw InputError("excluded view " + std::to_string(view) + " does not exist (the scene has " +
+                       std::to_string(all.size()) + " views)");
+  if (kept.size() < 2) throw InputError("fewer than 2 views are left to refine with");
+  return kept;
+}
+
+// g at every vertex of the current mesh (normals, visibility, g; no gradient), and the mean
+// colour of the visible views: what the output mesh carries and the summary reports.
+struct SurfaceState {
+  std::vector<float> g;
+  std::vector<Eigen::Vector3f> colours;
+  double sum_g_per_vertex = 0.0;
+};
+
+SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>& views, const RefineOptions& options) {
+  VertexFields fields;
+  fields.resize(mesh.n_vertices(), views.size());
+  const SurfaceQuery surface(mesh);
+  const double mean_edge = edge_lengths(mesh).mean;
+  SurfaceState state;
+  state.g.resize(mesh.n_vertices(), 0.0f);
+  state.colours.resize(mesh.n_vertices(), Eigen::Vector3f::Zero());
+  // Per vertex block in parallel: every vertex's values depend on that vertex alone.
+  const std::vector<IndexRange> blocks = split_into_blocks(mesh.n_vertices(), options.block_size);
+  oneapi::tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+    const IndexRange block = blocks[b];
+    compute_normals(mesh, block, fields);
+    compute_visibility(mesh, block, views, surface, mean_edge, options.visibility, fields);
+    drop_outlier_views(mesh, block, views, options.photo.photo, fields);
+    compute_photo_consistency(mesh, block, views, options.photo.photo, fields);
+    for (std::uint32_t v = block.begin; v < block.end; ++v) {
+      const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+      Eigen::Vector3d colour = Eigen::Vector3d::Zero();
+      for (const std::uint16_t id : fields.visible(v)) {
+        const PhotoView& view = views[id];
+        const Projection p = view.project(P);
+        colour += view.image->sample_bilinear(p.u, p.v).cast<double>();
+      }
+      if (fields.visible_count[v] > 0) state.colours[v] = (colour / fields.visible_count[v]).cast<float>();
+    }
+  });
+  // Σg in id order, whatever the blocks.
+  double sum = 0.0;
+  std::size_t defined = 0;
+  for (std::uint32_t v = 0; v < mesh.n_vertices(); ++v)
+    if (fields.defined[v] & kPhotoDefined) {
+      state.g[v] = static_cast<float>(fields.photo_consistency[v]);
+      sum += fields.photo_consistency[v];
+      ++defined;
+    }
+  state.sum_g_per_vertex = defined ? sum / static_cast<double>(defined) : 0.0;
+  return state;
+}
+
+RefineStatus status_of(StopReason reason) {
+  switch (reason) {
+    case StopReason::Converged: return RefineStatus::Converged;
+    case StopReason::StepSmall: return RefineStatus::StepSmall;
+    default: return RefineStatus::MaxIterations;
+  }
+}
+
+class Refinement {
+ public:
+  Refinement(const Scene& scene, const Mesh& initial, const RefineOptions& options, const RefineControl& control)
+      : options_(options), control_(control), full_views_(usable_views(scene, options.excluded_views)),
+        views_(full_views_), mesh_(initial.topology), data_(mesh_, views_, options_, control.cancel) {
+    data_.on_block = control.on_block;
+    for (int level = 0; level < options.image_levels; ++level)
+      levels_.push_back(half_resolution(level == 0 ? full_views_ : levels_.back()->views));
+    if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
+    if (options.keep_inside_silhouettes) {
+      inside_.emplace(full_views_, threshold_silhouettes(full_views_, options.silhouettes));
+      data_.inside = &*inside_;
+    }
+  }
+
+  RefineResult run() {
+    const auto start = Clock::now();
+    RefineResult result;
+    RefineSummary& summary = result.summary;
+    summary.initial_vertices = mesh_.n_vertices();
+    summary.initial_faces = mesh_.n_faces();
+    progress(0, RefineStage::Preparing);
+    prepare();
+    summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, options_).sum_g_per_vertex;
+
+    StoppingCriterion stopping(options_.stopping);
+    RefineStatus status = RefineStatus::MaxIterations;
+    for (int iteration = 1;; ++iteration) {
+      if (cancelled()) {
+        status = RefineStatus::Cancelled;
+        break;
+      }
+      const auto iteration_start = Clock::now();
+      IterationReport report;
+      report.iteration = iteration;
+      double refinement_seconds = 0.0;
+      // Refinement waits for the full-resolution images with either schedule.
+      const bool refine_now =
+          options_.refinement_schedule == RefinementSchedule::EveryIteration && iteration > 1 && levels_.empty();
+      if ((refine_now && adapt(report, refinement_seconds)) || !data_.surface) {
+        data_.reset_topology();
+        graph_.reset();
+      }
+      const EdgeLengths edges = edge_lengths(mesh_);
+      data_.set_edge_lengths(edges);
+      std::fill(std::begin(data_.serial_seconds), std::end(data_.serial_seconds), 0.0);
+      for (auto& slots : data_.block_seconds) slots.fill(0.0);
+
+      if (options_.engine == EngineKind::Graph) {
+        if (!graph_) graph_ = std::make_unique<IterationGraph>(data_);  // inside the arena: attaches to it
+        graph_->run();
+      } else {
+        run_iteration_sequential(data_);
+      }
+      if (cancelled() || data_.stopped) {  // its kernels skipped blocks: the iteration did not happen
+        status = RefineStatus::Cancelled;
+        break;
+      }
+      fill_report(report, edges, refinement_seconds, iteration_start);
+      StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move, data_.total.defined_g);
+      report.stop = to_string(reason);
+      const bool budget_left = stopping.iterations() < static_cast<std::size_t>(options_.stopping.max_iterations);
+      if (budget_left && refine_at_convergence(reason, report)) {
+        stopping.restart();
+        reason = StopReason::Continue;
+      }
+      summary.iterations.push_back(report);
+      announce(report);
+      if (reason != StopReason::Continue) {
+        status = status_of(reason);
+        break;
+      }
+    }
+
+    progress(static_cast<int>(summary.iterations.size()), RefineStage::Finishing);
+    if (status != RefineStatus::Cancelled) spread_unobserved();
+    const std::optional<UntanglingResult> untangled =
+        status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
+    summary.untangled_pairs = untangled_pairs_;
+    const SurfaceState final_state = evaluate_surface(mesh_, full_views_, options_);
+    summary.status = status;
+    summary.final_vertices = mesh_.n_vertices();
+    summary.final_faces = mesh_.n_faces();
+    summary.final_sum_g_per_vertex = final_state.sum_g_per_vertex;
+    // The untangling's last count holds unless the silhouette constraint cut its moves short.
+    const bool counted = untangled && !(inside_ && untangled->rounds > 0);
+    summary.self_intersections = counted ? untangled->crossing_pairs_after : count_self_intersections(mesh_);
+    result.mesh.topology = mesh_;
+    result.mesh.quality = final_state.g;
+    result.mesh.colors = final_state.colours;
+    summary.seconds = seconds_since(start);
+    return result;
+  }
+
+ private:
+  bool cancelled() const { return control_.cancel && control_.cancel->load(); }
+
+  void progress(int iteration, RefineStage stage) {
+    if (!control_.on_progress) return;
+    RefineProgress p;
+    p.iteration = iteration;
+    p.max_iterations = options_.stopping.max_iterations;
+    p.vertices = mesh_.n_vertices();
+    p.stage = stage;
+    control_.on_progress(p);
+  }
+
+  // Thesis §5.3.4, before the flow: split/collapse against e_S, one smoothing and one
+  // regularization pass over the whole mesh.
+  void prepare() {
+    reference_edge_ = edge_lengths(mesh_).shortest;
+    pixel_size_ = finest_pixel_size(full_views_, bounding_box_of(mesh_).centre());
+    if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
+    if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
+    apply_smoothing(mesh_, options_.smoothing);
+    apply_regularization(mesh_, options_.regularization);
+    if (options_.unobserved_displacement.enabled) reference_ = positions_of(mesh_);
+  }
+
+  // Removes the folds of the current surface (UntanglingOptions), counted for the summary;
+  // nothing (nullopt) when the untangling is disabled.
+  std::optional<UntanglingResult> untangle_folds() {
+    if (options_.untangling.max_rounds == 0) return std::nullopt;
+    const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
+    const UntanglingResult result = untangle(mesh_, options_.untangling);
+    untangled_pairs_ += result.crossing_pairs_before - result.crossing_pairs_after;
+    if (result.rounds > 0) limit_to_silhouettes(before);
+    if (control_.logger && result.crossing_pairs_before > 0)
+      control_.logger->info("untangled {} crossing face pairs ({} left) by smoothing {} vertices in {} rounds",
+                            result.crossing_pairs_before, result.crossing_pairs_after, result.smoothed_vertices,
+                            result.rounds);
+    return result;
+  }
+
+  // The silhouette constraint holds for the moves outside the flow too: each vertex moved since
+  // \p before (its positions then; empty without the constraint) is pulled back inside.
+  void limit_to_silhouettes(const std::vector<Eigen::Vector3d>& before) {
+    if (!inside_) return;
+    for (auto v : mesh_.vertices()) {
+      const Eigen::Vector3d& from = before[static_cast<std::size_t>(v.idx())];
+      const Eigen::Vector3d to = to_eigen(mesh_.point(v));
+      if (to != from) mesh_.set_point(v, to_openmesh(inside_->limit_move(from, to)));
+    }
+  }
+
+  // Moves the vertices the last iteration did not observe well with the observed surface
+  // (UnobservedDisplacementOptions); the fields still describe the current topology.
+  // True when vertices moved.
+  bool spread_unobserved() {
+    if (!options_.unobserved_displacement.enabled) return false;
+    const std::vector<std::uint8_t> poor =
+        poorly_observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement);
+    const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
+    const DisplacementResult result = spread_displacement(mesh_, reference_, poor);
+    if (result.moved_vertices > 0) limit_to_silhouettes(before);
+    if (control_.logger && result.moved_vertices > 0)
+      control_.logger->info("moved {} unobserved vertices with the observed surface", result.moved_vertices);
+    return result.moved_vertices > 0;
+  }
+
+  // Normals and curvature at the current positions for every vertex (after the untangling moved
+  // some), for the adaptive refinement's marks.
+  void update_curvature() {
+    const IndexRange all{0, static_cast<std::uint32_t>(mesh_.n_vertices())};
+    compute_normals(mesh_, all, data_.fields);
+    compute_mean_curvature(mesh_, all, data_.fields, options_.curvature);
+  }
+
+  // Adaptive refinement from the curvature of the last iteration (SPEC §5). True when the
+  // topology changed, so the blocks, fields, Embree scene and graph are rebuilt.
+  bool adapt(IterationReport& report, double& seconds) {
+    if (!options_.adaptive_refinement) return false;
+    const auto start = Clock::now();
+    const std::size_t faces = mesh_.n_faces();
+    const RefinementResult result = refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
+    if (options_.unobserved_displacement.enabled) extend_reference(reference_, result.parents);
+    report.refined_faces += mesh_.n_faces() - faces;
+    report.declined_vertices += result.declined;
+    seconds += seconds_since(start);
+    return mesh_.n_faces() != faces;
+  }
+
+  // The coarse-to-fine schedule: when the flow has settled on coarser images, the next finer ones
+  // (with either refinement schedule); at full resolution, refine; true when that changed the
+  // images or the mesh (the run goes on), recorded in \p report.
+  bool refine_at_convergence(StopReason reason, IterationReport& report) {
+    if (reason != StopReason::Converged && reason != StopReason::StepSmall) return false;
+    if (!levels_.empty()) {  // settled on these images: the next finer ones before any refinement
+      levels_.pop_back();
+      views_ = levels_.empty() ? full_views_ : levels_.back()->views;
+      data_.step_scale = 1.0;  // Σg/vertex on other images says nothing about the steps on these
+      data_.previous_g_per_vertex = 0.0;
+      report.stop = std::string("finer images (") + to_string(reason) + ")";
+      if (control_.logger) control_.logger->info("images at 1/{} of their resolution from here", 1 << levels_.size());
+      return true;
+    }
+    if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
+    const auto start = Clock::now();
+    const bool spread = spread_unobserved();
+    const std::optional<UntanglingResult> untangled = untangle_folds();
+    if (spread || (untangled && untangled->rounds > 0)) update_curvature();  // the marks follow the moves
+    double seconds = seconds_since(start);
+    const bool refined = adapt(report, seconds);
+    report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
+    if (!refined) return false;
+    report.stop = std::string("refined (") + to_string(reason) + ")";
+    data_.reset_topology();
+    graph_.reset();
+    return true;
+  }
+
+  void fill_report(IterationReport& report, const EdgeLengths& edges, double refinement_seconds,
+                   Clock::time_point iteration_start) {
+    report.vertices = mesh_.n_vertices();
+    report.faces = mesh_.n_faces();
+    report.sum_g = data_.total.sum_g;
+    report.defined_g = data_.total.defined_g;
+    report.moving = data_.moving;
+    report.shortest_edge = edges.shortest;
+    report.max_speed = data_.total.max_speed;
+    report.time_step = data_.time_step;
+    report.median_move = data_.median_move;
+    for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] = data_.serial_seconds[s];
+    for (const auto& slots : data_.block_seconds)  // block order: the same sum every run
+      for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] += slots[s];
+    report.stage_seconds[static_cast<int>(Stage::Refinement)] = refinement_seconds;
+    report.seconds = seconds_since(iteration_start);
+  }
+
+  void announce(const IterationReport& report) {
+    if (control_.logger)
+      control_.logger->info("iteration {:3d}  vertices {:7d}  Σg/vertex {:.6g}  Δt {:.4g}  max|F| {:.4g}  {:.3f} s",
+                            report.iteration, report.vertices, report.sum_g_per_vertex(), report.time_step,
+                            report.max_speed, report.seconds);
+    RefineProgress p;
+    p.iteration = report.iteration;
+    p.max_iterations = options_.stopping.max_iterations;
+    p.vertices = report.vertices;
+    p.sum_g_per_vertex = report.sum_g_per_vertex();
+    p.stage = RefineStage::Iterating;
+    if (control_.on_progress) control_.on_progress(p);  // first: on_iteration sees the same state
+    if (control_.on_iteration) control_.on_iteration(report);
+  }
+
+  const RefineOptions& options_;
+  const RefineControl& control_;
+  std::vector<PhotoView> full_views_;  //!< the photographs the refinement may use
+  std::vector<std::unique_ptr<ImageLevel>> levels_;  //!< halved once, twice, ...; dropped as the flow gets there
+  std::vector<PhotoView> views_;       //!< the views the iterations read now (a level's or the full ones)
+  TriMesh mesh_;
+  IterationData data_;
+  double reference_edge_ = 0.0;
+  double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
+  std::size_t untangled_pairs_ = 0;
+  // Where each vertex was when the flow started (UnobservedDisplacementOptions), midpoints for the
+  // vertices refinement added; empty when the option is off.
+  std::vector<Eigen::Vector3d> reference_;
+  std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
+  std::optional<SilhouetteConstraint> inside_;
+};
+
+}  // namespace
+
+const char* to_string(RefineStage stage) {
+  switch (stage) {
+    case RefineStage::Preparing: return "preparing";
+    case RefineStage::Iterating: return "iterating";
+    case RefineStage::Finishing: return "finishing";
+  }
+  return "?";
+}
+
+RefineResult refine_mesh(const Scene& scene, const Mesh& initial, const RefineOptions& options,
+                         const RefineControl& control) {
+  const auto start = Clock::now();
+  RefineResult result;
+  try {
+    options.check();
+    if (initial.n_faces() == 0) throw InputError("the initial mesh has no faces");
+    const int threads = control.threads > 0 ? control.threads : oneapi::tbb::info::default_concurrency();
+    // The engine's own arena: the host's default arena and thread count stay untouched.
+    oneapi::tbb::task_arena arena(threads);
+    arena.execute([&] {
+      Refinement refinement(scene, initial, options, control);
+      result = refinement.run();
+    });
+  } catch (const std::exception& e) {
+    result.summary.status = RefineStatus::Failed;
+    result.summary.message = e.what();
+    result.summary.seconds = seconds_since(start);
+    if (control.logger) control.logger->error("{}", e.what());
+  }
+  return result;
+}
+
+}  // namespace mvflow

@@ -1,0 +1,103 @@
+#pragma once
+// Photo consistency g (SPEC §3; thesis eq. 4.14, §5.3.3, figure 5.3b): project a point into
+// each of its views, take the (2h+1)×(2h+1) patch around the projection (bilinear), and sum the
+// unbiased variance across views over channels and patch offsets, averaged over the offsets:
+//   var_{c,o} = (Σ_i C_i² − (Σ_i C_i)²/m) / (m − 1),   g = Σ_c (1/(2h+1)²) Σ_o var_{c,o}.
+// g ≥ 0, 0 when all views agree; undefined with fewer than 2 usable views (a view whose patch
+// would leave its image does not count for that point).
+// Computed as (Σ_i Σ_o C² − Σ_o (Σ_i C)²/m) / ((m − 1)·(2h+1)²) with the sums in double; each
+// patch value is interpolated in float (along the row, then down), which puts g within 1e-5
+// relative of a double-precision evaluation (tests/stages_photo_test.cpp measures 2.5e-6).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "engine/model/mesh.h"
+#include "engine/model/vertex_fields.h"
+#include "stages/flow/photo_views.h"
+
+namespace mvflow {
+
+struct PhotoConsistencyOptions {
+  int half_patch = 2;  //!< patch of (2·half_patch+1)² pixels; 2 = the thesis's 5×5 (range 1..7)
+  //! Per-view gain/bias normalisation of the patches before the variance (stages/flow/photo_robust.h):
+  //! exposure and lighting that differ between photographs no longer count as inconsistency.
+  //! false: the thesis's g on raw colours.
+  bool normalize = false;
+  //! σ₀ of the normalisation on [0,1] values, ≥ 0: patches with less contrast than this are not
+  //! stretched to unit contrast (their noise would be). 0.02 ≈ 5 grey levels of 8-bit photos.
+  double noise_floor = 0.02;
+  //! Up to this many outlier views are removed from a vertex's view set (stages/flow/photo_robust.h)
+  //! while more than min_views remain; 0 keeps every view (the thesis).
+  int drop_views = 0;
+  int min_views = 4;  //!< views kept at least when dropping outliers (≥ 2)
+  bool check() const {
+    return half_patch >= 1 && half_patch <= 7 && noise_floor >= 0 && noise_floor <= 1 && drop_views >= 0 &&
+           drop_views <= 64 && min_views >= 2;
+  }
+};
+
+//! g at one point and the number of views that contributed.
+struct PhotoValue {
+  double g = 0.0;
+  int views = 0;
+  bool defined() const { return views >= 2; }
+};
+
+namespace detail {
+
+//! The most values one patch has (half_patch 7: 15 × 15 pixels × RGB).
+inline constexpr int kMaxPatchValues = 3 * 15 * 15;
+
+//! The 3·(2h+1)² values of the patch of \p view around \p X (rows top to bottom, RGB
+//! interleaved), each interpolated in float along the row, then down: h = a + fx·(b − a),
+//! C = h + fy·(h' − h). False (nothing written) when X is behind the camera or the patch with its
+//! bilinear support leaves the image.
+bool read_patch(const PhotoView& view, const Eigen::Vector3d& X, int half_patch, float* out);
+
+//! Σ_i C per patch value and Σ_i Σ_values C² over the views added, in double and in the order
+//! added, and g from them: (Σ C² − Σ_values (Σ_i C)²/m) / ((m − 1)·side²).
+class PatchVariance {
+ public:
+  explicit PatchVariance(int half_patch);
+  void add(const float* patch);
+  PhotoValue finish() const;
+
+ private:
+  int side_;
+  int count_;
+  int views_ = 0;
+  double squares_ = 0.0;
+  double sum_[kMaxPatchValues];
+};
+
+}  // namespace detail
+
+//! g(X) over the views \p view_ids of \p views.
+PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
+                             const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options = {});
+
+//! g at every vertex of \p vertices over its visible views (fields.visible_views, from the
+//! visibility stage). Writes photo_consistency and the kPhotoDefined bit of those vertices only.
+void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
+                               const PhotoConsistencyOptions& options, VertexFields& fields);
+
+//! The points of the gradient's 6·half + 1 samples of g around \p X, in the slots the gradient
+//! stage reads: slot 0 = X, then X + s·spacing·e_a for a = x, y, z and s = −half..−1, 1..half.
+//! Calls visit(slot, point) in slot order while it returns true.
+template <class Visit>
+void for_each_gradient_sample(const Eigen::Vector3d& X, double spacing, int half, Visit visit) {
+  std::size_t slot = 0;
+  if (!visit(slot++, X)) return;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int s = -half; s <= half; ++s) {
+      if (s == 0) continue;
+      Eigen::Vector3d sample = X;
+      sample[axis] += s * spacing;
+      if (!visit(slot++, sample)) return;
+    }
+}
+
+}  // namespace mvflow

@@ -1,0 +1,52 @@
+#include "stages/flow/photo_views.h"
+
+#include <oneapi/tbb/parallel_for.h>
+
+#include "engine/model/error.h"
+
+namespace mvflow {
+
+std::vector<PhotoView> make_photo_views(const std::vector<Camera>& cameras, const std::vector<const Image*>& images) {
+  MVFLOW_CHECK(cameras.size() == images.size(), "one image per camera");
+  std::vector<PhotoView> views(cameras.size());
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const Camera& camera = cameras[i];
+    MVFLOW_CHECK(images[i] != nullptr, "image missing");
+    MVFLOW_CHECK(images[i]->width() == camera.width() && images[i]->height() == camera.height(),
+                 "image size differs from its camera's");
+    views[i] = {&camera, images[i], camera.projection_matrix(), camera.distortion().is_identity(), camera.width(),
+                camera.height()};
+  }
+  return views;
+}
+
+double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vector3d& point) {
+  double finest = 0.0;
+  for (const PhotoView& view : views) {
+    const Camera& camera = *view.camera;
+    const double depth = (camera.R() * point + camera.t()).z();
+    const double focal = camera.focal_pixels();
+    if (!(depth > 0) || !(focal > 0)) continue;
+    const double size = depth / focal;
+    if (finest == 0.0 || size < finest) finest = size;
+  }
+  return finest;
+}
+
+std::vector<PhotoView> make_photo_views(const Scene& scene) {
+  // Decode the images side by side (the store is safe to use from any thread), in the caller's
+  // task arena.
+  oneapi::tbb::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t i) { scene.image(i); });
+  std::vector<PhotoView> views(scene.size());
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    const Camera& camera = scene.views[i].camera;
+    const Image& image = scene.image(i);
+    MVFLOW_CHECK(image.width() == camera.width() && image.height() == camera.height(),
+                 "image size differs from its camera's");
+    views[i] = {&camera, &image, camera.projection_matrix(), camera.distortion().is_identity(), camera.width(),
+                camera.height()};
+  }
+  return views;
+}
+
+}  // namespace mvflow

@@ -1,0 +1,94 @@
+#include "stages/flow/stopping.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "engine/model/error.h"
+
+namespace mvflow {
+
+const char* to_string(StopReason reason) {
+  switch (reason) {
+    case StopReason::Continue:
+      return "continue";
+    case StopReason::Converged:
+      return "converged";
+    case StopReason::StepSmall:
+      return "step-small";
+    case StopReason::MaxIterations:
+      return "max-iterations";
+  }
+  return "unknown";
+}
+
+bool StoppingOptions::check() const {
+  return epsilon_percent > 0.0 && std::isfinite(epsilon_percent) && lookback >= 1 &&
+         min_iterations >= lookback + 1 && max_iterations >= min_iterations && median_move_tolerance >= 0.0 &&
+         std::isfinite(median_move_tolerance);
+}
+
+StoppingCriterion::StoppingCriterion(StoppingOptions options) : options_(options) {
+  MVFLOW_CHECK(options_.check(), "StoppingCriterion: invalid StoppingOptions");
+  history_.reserve(static_cast<std::size_t>(options_.max_iterations));
+}
+
+namespace {
+
+double relative_change_percent(double current, double previous) {
+  if (previous == 0.0) return current == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
+  return std::abs(100.0 - 100.0 * current / previous);
+}
+
+}  // namespace
+
+double StoppingCriterion::change_percent(std::size_t lag) const {
+  return relative_change_percent(history_.back(), history_[history_.size() - 1 - lag]);
+}
+
+bool StoppingCriterion::converged() const {
+  const auto w = static_cast<std::size_t>(options_.lookback);
+  if (options_.test == ConvergenceTest::NoImprovement) {
+    // A NaN in the window holds convergence off; earlier NaNs are skipped.
+    const std::vector<double>& g = history_per_vertex_;
+    const auto split = g.end() - static_cast<std::ptrdiff_t>(w);  // ≥ 1 value before it
+    if (std::any_of(split, g.end(), [](double x) { return std::isnan(x); })) return false;
+    const double recent = *std::min_element(split, g.end());
+    double earlier = std::numeric_limits<double>::infinity();
+    for (auto it = g.begin(); it != split; ++it)
+      if (*it < earlier) earlier = *it;  // false for NaN
+    if (std::isinf(earlier)) return false;
+    if (earlier == 0.0) return true;  // nothing left to improve
+    return 100.0 - 100.0 * recent / earlier < options_.epsilon_percent;
+  }
+  for (std::size_t lag = 1; lag <= w; ++lag)
+    if (!(change_percent(lag) < options_.epsilon_percent)) return false;
+  return true;
+}
+
+void StoppingCriterion::restart() {
+  before_restart_ += history_.size();
+  history_.clear();
+  history_per_vertex_.clear();
+}
+
+std::vector<double> StoppingCriterion::last_changes_percent() const {
+  std::vector<double> changes;
+  for (std::size_t lag = 1; lag <= static_cast<std::size_t>(options_.lookback) && lag < history_.size();
+       ++lag)
+    changes.push_back(change_percent(lag));
+  return changes;
+}
+
+StopReason StoppingCriterion::add_iteration(double sum_g, double median_move_over_emin, std::size_t vertices_with_g) {
+  history_.push_back(sum_g);
+  history_per_vertex_.push_back(vertices_with_g > 0 ? sum_g / static_cast<double>(vertices_with_g) : sum_g);
+  if (history_.size() >= static_cast<std::size_t>(options_.min_iterations)) {
+    if (converged()) return StopReason::Converged;
+    if (median_move_over_emin < options_.median_move_tolerance) return StopReason::StepSmall;
+  }
+  if (iterations() >= static_cast<std::size_t>(options_.max_iterations)) return StopReason::MaxIterations;
+  return StopReason::Continue;
+}
+
+}  // namespace mvflow

@@ -1,0 +1,82 @@
+#pragma once
+// The regions the photographs do not constrain move with the observed surface around them
+// (README, "Defaults and differences"). A vertex seen only at grazing angles, occluded or outside
+// every image has no reliable speed, so such a region would keep the initial surface's error
+// while its observed border converges. Here the displacement of the observed vertices from the
+// surface the flow started on (their signed distance to it) is spread over the rest
+// by the cotangent Laplace equation (a harmonic interpolation: it stays between its boundary
+// values, so the noise of the observed border is averaged, never amplified), and every such
+// vertex is placed at its starting position moved by that amount along its starting normal.
+// A sphere offset by a constant comes back to the sphere exactly, whatever the region's size.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/model/mesh.h"
+#include "engine/model/vertex_fields.h"
+#include "stages/flow/photo_views.h"
+
+namespace mvflow {
+
+struct UnobservedDisplacementOptions {
+  //! Move the unobserved vertices with the observed surface each time the flow has converged at
+  //! one resolution and at the end of the run. Off (the default and the thesis, §5.3.3: such
+  //! vertices move only by smoothing and regularization): it brings a grazing-only cap back to
+  //! the surface on a smooth object but made the held-out error of real photographs and a
+  //! bumpy object's weakly seen underside worse (README, "Defaults and differences").
+  bool enabled = false;
+  //! A vertex counts as observed when it has a speed and one of the views it uses lies within
+  //! this angle of its normal (degrees, in (0, 90]). 90: every vertex with a speed.
+  double observed_angle_degrees = 90.0;
+  //! The observed set is shrunk by this many vertex rings before it is followed (a vertex stays
+  //! observed only if its whole one ring is, ring by ring): the ragged border of the observed
+  //! region and isolated "observed" vertices inside an unobserved one are the least reliable
+  //! (on a sphere whose cap is seen only at grazing angles, 0 rings left spikes of 0.03 in the
+  //! cap, 2 or more pulled it in; README, "Quality"). ≥ 0.
+  int erode_rings = 1;
+
+  bool check() const { return observed_angle_degrees > 0 && observed_angle_degrees <= 90 && erode_rings >= 0; }
+};
+
+//! One flag per vertex: 1 unless the last iteration gave it a speed (kSpeedDefined) and, with
+//! options.observed_angle_degrees < 90, one of the views in fields.visible(v) lies within that
+//! angle of fields.normal[v], and the same holds for every vertex within options.erode_rings
+//! rings of it.
+//! \throw Error if the options are invalid or the fields are not sized for the mesh.
+std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
+                                                   const VertexFields& fields,
+                                                   const UnobservedDisplacementOptions& options);
+
+struct DisplacementResult {
+  std::size_t moved_vertices = 0;    //!< free vertices placed by the interpolation
+  std::size_t skipped_vertices = 0;  //!< free vertices in regions with no fixed neighbour
+};
+
+//! For the vertices with \p free[v] != 0 (boundary vertices excepted): with R the \p reference
+//! positions, N_R the area-weighted vertex normals of the mesh's faces at those positions and
+//! d_j = (P_j − R_j)·N_R,j at the other vertices, solves Σ_j w_ij (d_j − d_i) = 0 at every free i
+//! (w_ij the cotangent weights of the reference surface, on which d lives, clamped into
+//! [0.01, 1000] so the system is positive definite) and sets P_i = R_i + d_i·N_R,i. A connected free region with no fixed
+//! neighbour (nothing observed to follow) is left as it is and counted as skipped. Serial and
+//! deterministic (one sparse Cholesky solve).
+//! \param mesh      The surface, positions of free vertices modified; topology unchanged.
+//! \param reference One position per vertex: where the flow started.
+//! \param free      One flag per vertex.
+//! \pre \p mesh has no deleted elements (ids contiguous).
+//! \throw Error if a size differs from #V or the solve fails.
+DisplacementResult spread_displacement(TriMesh& mesh, std::span<const Eigen::Vector3d> reference,
+                                       std::span<const std::uint8_t> free);
+
+//! Appends the reference positions of the vertices an adaptive refinement added (RefinementResult
+//! ::parents): each the midpoint of its split edge's references, as the vertex itself is of the
+//! edge's positions.
+//! \throw Error if a parent is not an existing reference.
+void extend_reference(std::vector<Eigen::Vector3d>& reference,
+                      std::span<const std::array<std::uint32_t, 2>> parents);
+
+}  // namespace mvflow
