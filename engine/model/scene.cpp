@@ -32,4 +32,14 @@ void ImageStore::set(std::size_t view, Image image) {
   slots_[view]->image = std::make_unique<Image>(std::move(image));
 }
 
+Scene in_memory_scene(std::vector<View> views, std::vector<Image> images, const BoundingBox& bounding_box) {
+  MVFLOW_CHECK(images.size() == views.size(), "in_memory_scene: one image per view");
+  Scene scene;
+  scene.views = std::move(views);
+  scene.images = std::make_shared<ImageStore>(scene.views.size(), nullptr);
+  for (std::size_t i = 0; i < images.size(); ++i) scene.images->set(i, std::move(images[i]));
+  scene.bounding_box = bounding_box;
+  return scene;
+}
+
 }  // namespace mvflow

@@ -54,4 +54,9 @@ struct Scene {
   const Image& image(std::size_t view) const { return images->get(view); }
 };
 
+//! A scene held in memory (no files behind it): \p views with their \p images (one each), for
+//! programs that embed mvflow, the refiner's tests and benchmarks that render instead of reading.
+//! \throw Error when the counts differ.
+Scene in_memory_scene(std::vector<View> views, std::vector<Image> images, const BoundingBox& bounding_box = {});
+
 }  // namespace mvflow

@@ -64,9 +64,6 @@ struct SynthScene {
 SynthScene make_synth_scene(const IndexedMesh& truth, std::shared_ptr<const Image> uv_texture,
                             const SynthOptions& options);
 
-//! A scene held in memory (no files behind it): \p views with their \p images (one each), for
-//! the refiner, tests and benchmarks that render instead of reading.
-Scene in_memory_scene(std::vector<View> views, std::vector<Image> images, const BoundingBox& bounding_box = {});
 
 //! The renderer make_synth_scene uses, exposed for tests and tools that render more views.
 SynthRenderer make_synth_renderer(const IndexedMesh& truth, std::shared_ptr<const Image> uv_texture,
