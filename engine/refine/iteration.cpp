@@ -219,26 +219,34 @@ void IterationData::commit(std::size_t block) {
   run_block(*this, block, nullptr, [&] { commit_positions(mesh, blocks[block], new_positions, inside); });
 }
 
-void run_iteration_sequential(IterationData& data) {
-  const std::size_t n = data.blocks.size();
-  data.refit();
-  for (std::size_t b = 0; b < n; ++b) data.geometry(b);
-  for (std::size_t b = 0; b < n; ++b) data.visibility(b);
-  for (std::size_t b = 0; b < n; ++b) data.photo_speed(b);
-  data.cfl();
-  for (std::size_t b = 0; b < n; ++b) data.move(b);
-  for (int step = 0; step < data.options.smoothing.steps; ++step) {
-    for (std::size_t b = 0; b < n; ++b) data.smooth(b);
-    for (std::size_t b = 0; b < n; ++b) data.commit(b);
-    if (data.options.smoothing.taubin_pass_band > 0.0) {
-      for (std::size_t b = 0; b < n; ++b) data.inflate(b);
-      for (std::size_t b = 0; b < n; ++b) data.commit(b);
+IterationPhases iteration_phases(const RefineOptions& options) {
+  IterationPhases schedule{
+      .pipeline = {&IterationData::geometry, &IterationData::visibility, &IterationData::photo_speed}, .phases = {}};
+  schedule.phases.push_back(&IterationData::move);
+  for (int step = 0; step < options.smoothing.steps; ++step) {
+    schedule.phases.push_back(&IterationData::smooth);
+    schedule.phases.push_back(&IterationData::commit);
+    if (options.smoothing.taubin_pass_band > 0.0) {
+      schedule.phases.push_back(&IterationData::inflate);
+      schedule.phases.push_back(&IterationData::commit);
     }
   }
-  for (int step = 0; step < data.options.regularization.steps; ++step) {
-    for (std::size_t b = 0; b < n; ++b) data.regularize(b);
-    for (std::size_t b = 0; b < n; ++b) data.commit(b);
+  for (int step = 0; step < options.regularization.steps; ++step) {
+    schedule.phases.push_back(&IterationData::regularize);
+    schedule.phases.push_back(&IterationData::commit);
   }
+  return schedule;
+}
+
+void run_iteration_sequential(IterationData& data) {
+  const IterationPhases schedule = iteration_phases(data.options);
+  const std::size_t n = data.blocks.size();
+  data.refit();
+  for (BlockKernel kernel : schedule.pipeline)
+    for (std::size_t b = 0; b < n; ++b) (data.*kernel)(b);
+  data.cfl();
+  for (BlockKernel kernel : schedule.phases)
+    for (std::size_t b = 0; b < n; ++b) (data.*kernel)(b);
   data.measure_moves();
 }
 

@@ -101,8 +101,29 @@ struct IterationData {
   void commit(std::size_t block);      //!< new positions into the mesh
 };
 
-//! Runs one iteration's kernels in a plain loop on the calling thread, in the order the graph's
-//! edges impose: the reference path for determinism tests and benchmarks.
+//! A per-block kernel of IterationData.
+using BlockKernel = void (IterationData::*)(std::size_t block);
+
+//! The phases of one iteration, the one schedule both engines walk (IterationGraph and
+//! run_iteration_sequential):
+//!   1. refit (serial);
+//!   2. `pipeline` per block: each block's kernels in order, independent of the other blocks, so
+//!      the graph pipelines them (a block's photo node starts when its own visibility is done);
+//!   3. cfl (serial): joins every block's partial;
+//!   4. each of `phases` on every block, all blocks of one phase before any block of the next
+//!      (a phase reads the neighbours' output of the one before, across blocks);
+//!   5. measure_moves (serial).
+struct IterationPhases {
+  std::array<BlockKernel, 3> pipeline;
+  std::vector<BlockKernel> phases;
+};
+
+//! The phases of an iteration under \p options: move; per smoothing step smooth, commit (and
+//! inflate, commit with a Taubin pass band); per regularization step regularize, commit.
+IterationPhases iteration_phases(const RefineOptions& options);
+
+//! Runs one iteration's kernels in a plain loop on the calling thread, phase by phase and block by
+//! block (iteration_phases): the reference path for determinism tests and benchmarks.
 void run_iteration_sequential(IterationData& data);
 
 }  // namespace mvflow

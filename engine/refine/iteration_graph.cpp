@@ -1,5 +1,7 @@
 #include "engine/refine/iteration_graph.h"
 
+#include <oneapi/tbb/parallel_for.h>
+
 namespace mvflow {
 
 namespace flow = oneapi::tbb::flow;
@@ -9,49 +11,33 @@ IterationGraph::Node* IterationGraph::add(std::function<void()> body) {
   return nodes_.back().get();
 }
 
-IterationGraph::Node* IterationGraph::barrier() {
-  return add([] {});
-}
-
 IterationGraph::IterationGraph(IterationData& data) : n_blocks_(data.blocks.size()) {
+  const IterationPhases schedule = iteration_phases(data.options);
   const std::size_t n = n_blocks_;
   start_ = add([&data] { data.refit(); });
 
-  // Per block: geometry → visibility → photo/gradient/speed, pipelined independently.
+  // Per block, the pipeline's kernels in a chain, each block independent of the others.
   Node* cfl = add([&data] { data.cfl(); });
   for (std::size_t b = 0; b < n; ++b) {
-    Node* geometry = add([&data, b] { data.geometry(b); });
-    Node* visibility = add([&data, b] { data.visibility(b); });
-    Node* photo = add([&data, b] { data.photo_speed(b); });
-    flow::make_edge(*start_, *geometry);
-    flow::make_edge(*geometry, *visibility);
-    flow::make_edge(*visibility, *photo);
-    flow::make_edge(*photo, *cfl);  // the reduction waits for every block's partial
+    Node* last = start_;
+    for (BlockKernel kernel : schedule.pipeline) {
+      Node* node = add([&data, b, kernel] { (data.*kernel)(b); });
+      flow::make_edge(*last, *node);
+      last = node;
+    }
+    flow::make_edge(*last, *cfl);  // the reduction waits for every block's partial
   }
 
-  // A phase of per-block nodes between two barriers: every block of the next phase may read
-  // any block's output of this one (smoothing reads the neighbours' moved positions).
-  auto phase = [&](Node* before, auto kernel) {
-    Node* after = barrier();
-    for (std::size_t b = 0; b < n; ++b) {
-      Node* node = add([&data, b, kernel] { (data.*kernel)(b); });
-      flow::make_edge(*before, *node);
-      flow::make_edge(*node, *after);
-    }
-    return after;
-  };
-  Node* last = phase(cfl, &IterationData::move);
-  for (int step = 0; step < data.options.smoothing.steps; ++step) {
-    last = phase(last, &IterationData::smooth);
-    last = phase(last, &IterationData::commit);
-    if (data.options.smoothing.taubin_pass_band > 0.0) {
-      last = phase(last, &IterationData::inflate);
-      last = phase(last, &IterationData::commit);
-    }
-  }
-  for (int step = 0; step < data.options.regularization.steps; ++step) {
-    last = phase(last, &IterationData::regularize);
-    last = phase(last, &IterationData::commit);
+  // One node per later phase: every block of the next phase may read any block's output of this
+  // one (smoothing reads the neighbours' moved positions), so the phase's blocks run as a
+  // parallel_for inside the node, and the edge to the next node is the barrier.
+  Node* last = cfl;
+  for (BlockKernel kernel : schedule.phases) {
+    Node* node = add([&data, n, kernel] {
+      oneapi::tbb::parallel_for(std::size_t{0}, n, [&data, kernel](std::size_t b) { (data.*kernel)(b); });
+    });
+    flow::make_edge(*last, *node);
+    last = node;
   }
   flow::make_edge(*last, *add([&data] { data.measure_moves(); }));
 }

@@ -1,15 +1,18 @@
 #pragma once
 // One deformation iteration as a oneTBB flow graph (SPEC §6): a dependence graph of
-// continue_nodes over the shared IterationData (the shape of oneTBB's cholesky example).
+// continue_nodes over the shared IterationData (the shape of oneTBB's cholesky example), built
+// from iteration_phases (engine/refine/iteration.h), the schedule the sequential path walks too.
 //
 //   refit ─┬─ geometry₀ → visibility₀ → photo₀ ─┐
 //          ├─ geometry₁ → visibility₁ → photo₁ ─┤
-//          └─ …                                  ┴─ cfl ─┬─ move₀ ─┐
-//                                                        └─ move₁ ─┴─ moved ─ smooth_b … ─ commit_b … ─ regularize_b … ─ commit_b … ─ done
+//          └─ …                                  ┴─ cfl ─ move ─ smooth ─ commit ─ … ─ regularize ─ commit ─ measure
 //
-// A block's photo node starts as soon as its own geometry and visibility are done; the only
-// global barrier before the CFL reduction is the refit. Built once per topology (the block
-// count and ranges are baked into the nodes); run many times.
+// Before the CFL reduction, nodes per block where they buy pipelining: a block's photo node
+// starts as soon as its own geometry and visibility are done, and the only global barrier is the
+// refit. After it, every phase reads neighbours across blocks, so each phase is one node whose
+// body is a parallel_for over the blocks (the graph is the coarse level, oneTBB's nested
+// parallelism). Built once per topology (the block count and ranges are baked into the nodes);
+// run many times.
 
 #include <memory>
 #include <vector>
@@ -39,7 +42,6 @@ class IterationGraph {
  private:
   using Node = oneapi::tbb::flow::continue_node<oneapi::tbb::flow::continue_msg>;
   Node* add(std::function<void()> body);
-  Node* barrier();
 
   oneapi::tbb::flow::graph graph_;  // declared before the nodes: it must outlive them
   std::vector<std::unique_ptr<Node>> nodes_;
