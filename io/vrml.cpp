@@ -169,10 +169,14 @@ class VrmlReader {
     const Token& t = peek();
     if (t.kind == Kind::OpenBracket) return skip_balanced();
     if (t.kind == Kind::Word && t.text == "USE") {
-      pos_ += 2;
+      next();
+      expect(Kind::Word, "a name after USE");
       return;
     }
-    if (t.kind == Kind::Word && t.text == "DEF") pos_ += 2;
+    if (t.kind == Kind::Word && t.text == "DEF") {
+      next();
+      expect(Kind::Word, "a name after DEF");
+    }
     if (peek().kind == Kind::Word && peek(1).kind == Kind::OpenBrace) {
       next();
       return skip_balanced();
@@ -187,12 +191,14 @@ class VrmlReader {
   void statement() {
     const Token& t = peek();
     if (t.kind == Kind::Word && (t.text == "PROTO" || t.text == "EXTERNPROTO")) {
-      pos_ += 2;  // keyword and name
+      next();
+      expect(Kind::Word, "a name after " + describe(t));
       if (peek().kind == Kind::OpenBracket) skip_balanced();
       if (peek().kind == Kind::OpenBrace) skip_balanced();  // PROTO body
       else skip_value();                                   // EXTERNPROTO url
     } else if (t.kind == Kind::Word && t.text == "ROUTE") {
-      pos_ += 4;  // ROUTE a.field TO b.field
+      next();  // ROUTE a.field TO b.field
+      for (const char* part : {"a node.field after ROUTE", "TO", "a node.field after TO"}) expect(Kind::Word, part);
     } else if (node_starts()) {
       node(Eigen::Affine3d::Identity());
     } else {
@@ -203,7 +209,8 @@ class VrmlReader {
   void node(const Eigen::Affine3d& transform) {
     std::string def_name;
     if (peek().text == "USE") {  // re-used geometry is not duplicated
-      pos_ += 2;
+      next();
+      expect(Kind::Word, "a name after USE");
       return;
     }
     if (peek().text == "DEF") {
@@ -236,6 +243,7 @@ class VrmlReader {
     if (peek().kind == Kind::OpenBracket) {
       next();
       while (peek().kind != Kind::CloseBracket) {
+        if (peek().kind == Kind::End) fail(peek(), "expected ']' to close the list, got the end of the file");
         if (node_starts()) node(transform);
         else next();
       }

@@ -228,5 +228,32 @@ TEST(FuzzRegression, JpegWithZeroSegmentLengthTiffAndOtherFormats) {
   EXPECT_LT(largest_allocation_of([&] { read_image(hdr_file); }), 1u << 20);
 }
 
+// vrml_fuzzer (2026-11-24, a timeout): USE as the last item of a list ("[ ... USE ]") skipped the
+// name that USE takes and the list's closing ']' with it, and the list loop then waited at the end
+// of the file for its ']' forever. USE, DEF, PROTO and ROUTE now read their names as words, so
+// that a bracket or brace in their place is named, and a list that reaches the end of the file is
+// an error.
+TEST(FuzzRegression, VrmlUseWithoutANameAtTheEndOfAList) {
+  ScratchFolder folder;
+  const fs::path file = folder / "mesh.wrl";
+  write_text(file, "#VRML V2.0 utf8\nShape { appearance [ USE ] }\n");
+  std::string message = input_error_of([&] { read_vrml(file); });
+  EXPECT_TRUE(contains(message, file.string() + ":2: expected a name after USE, got ']'")) << message;
+  const std::string found(
+      "#VRML V2.0 utf8\n# ten by mvflow\nShape {\n  appate {\n      0.5 0 0  ape\x8d{\n  appearancerdinate "
+      "{\n      point [\n        0.5 0 0,\n        -0.5 0 0,\n   USE       ]\n  }\n}\x90\xf3:\x00}\n}\x90"
+      "\xf3:\x00""0`\x00\x00\n",
+      179);
+  write_text(file, found);
+  message = input_error_of([&] { read_vrml(file); });
+  EXPECT_TRUE(contains(message, file.string() + ":")) << message;
+  for (const char* text : {"#VRML V2.0 utf8\nShape { geometry USE }\n", "#VRML V2.0 utf8\nDEF { }\n",
+                           "#VRML V2.0 utf8\nPROTO [ ] { }\n", "#VRML V2.0 utf8\nROUTE a.b TO [ ]\n"}) {
+    write_text(file, text);
+    message = input_error_of([&] { read_vrml(file); });
+    EXPECT_TRUE(contains(message, file.string() + ":2: expected ")) << text << ": " << message;
+  }
+}
+
 }  // namespace
 }  // namespace mvflow::io
