@@ -130,14 +130,24 @@ std::optional<HeaderSize> tiff_size(std::istream& in) {
   in.seekg(u32(&header[4]));
   unsigned char count_bytes[2];
   if (!in.read(reinterpret_cast<char*>(count_bytes), 2)) return std::nullopt;
+  // Every width or height entry counts and the largest wins: libtiff reads the first of a repeated
+  // tag and skips an entry of a type it does not read as a size, so the last entry (or a zero
+  // for such a type) could state a smaller image than the one decoded.
   std::optional<std::uint32_t> width, height;
   for (std::uint32_t i = 0, n = u16(count_bytes); i < n; ++i) {
     unsigned char entry[12];
     if (!in.read(reinterpret_cast<char*>(entry), 12)) return std::nullopt;
     const std::uint32_t tag = u16(entry), type = u16(entry + 2);
     if (tag != 256 && tag != 257) continue;
-    const std::uint32_t value = type == 3 ? u16(entry + 8) : type == 4 ? u32(entry + 8) : 0;
-    (tag == 256 ? width : height) = value;
+    std::uint32_t value = 0;
+    switch (type) {
+      case 1: case 6: value = entry[8]; break;           // BYTE, SBYTE
+      case 3: case 8: value = u16(entry + 8); break;     // SHORT, SSHORT (a negative one is huge here)
+      case 4: case 9: value = u32(entry + 8); break;     // LONG, SLONG
+      default: continue;                                 // not a size libtiff reads
+    }
+    std::optional<std::uint32_t>& side = tag == 256 ? width : height;
+    side = std::max(side.value_or(0), value);
   }
   if (!width || !height) return std::nullopt;
   return HeaderSize{*width, *height};

@@ -255,5 +255,35 @@ TEST(FuzzRegression, VrmlUseWithoutANameAtTheEndOfAList) {
   }
 }
 
+// mask_fuzzer (2026-11-24, out of memory): a TIFF whose directory holds the height twice, first
+// 65528 as a SHORT, then an entry of an unknown type. mvflow's header reader took the last entry
+// (a height of 0, within the limits), libtiff the first: OpenCV allocated 14856x65528 pixels
+// (2.9 GB). The reader now takes the largest width and height of every entry libtiff could read
+// as one, so the image is refused from its header.
+TEST(FuzzRegression, TiffWithARepeatedHeightTag) {
+  ScratchFolder folder;
+  const fs::path file = folder / "mask.tif";
+  const std::string found(
+      "II*\x00\"\x00\x00\x00\x80\x00 P8#\xfe\x06\x01\x81\xc1\xa0P\x88\x14(\x01\x0c\x00""C\xa2\x10H\x14\x04"
+      "\x00\x0c\x00\x00\x01\x03\x00\x01\x00\x00\x00\x08://\x01\x01\x03\x00\x01\x00\x00\x00\xf8\xff\xff\xff"
+      "\xfd\xfe\xfc\xff\x01\x00\x00\x00\x08\x00\x00\x00\x03\x01\x03\x00\x01\x00\x00\x00\x05\x00\x00\x00\x06"
+      "\x01\x03\x00\x01\x00\x00\x00\x01\x00\x00\x00\x11\x01\x04\x00\x01\x00\x00\x00\x18\x00\x00\x00\x15\x01"
+      "\x03\x00\x01\x00\x00\x00\x01\x00\x00\x00\x16\x01\x03\x00\x01\x00\x00\x00\x06\x00\x00\x00\x17\x01\x04"
+      "\x00\x01\x00\x00\x00\x19\x00\x00\x00\x1c\x01\x03\x00\x01\x00\x00\x00\x01\x00=\x00\x01\x01^\x00\x00"
+      "\x00\x00\x00\x02\x00\x00\x00S\x01\x03\x00\x01\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00",
+      184);
+  write_text(file, found);
+  for (const bool size_only : {true, false}) {
+    const std::string message = input_error_of([&] {
+      if (size_only)
+        read_image_size(file);
+      else
+        read_image(file);
+    });
+    EXPECT_TRUE(contains(message, file.string() + ": the image is 14856x65528 pixels")) << message;
+  }
+  EXPECT_LT(largest_allocation_of([&] { read_image(file); }), 1u << 20);
+}
+
 }  // namespace
 }  // namespace mvflow::io
