@@ -1,10 +1,10 @@
-# CTest: the layer check (cmake/MvflowLayers.cmake, run by cmake/check_layers.cmake) accepts a
+# CTest: the layer check (tools/cmake/MvflowLayers.cmake, run by tools/cmake/check_layers.cmake) accepts a
 # clean fixture and refuses a planted include across layers, naming the file, the include and the
 # layers the file may include. Fixture: tests/layers/fixture (model <- flow, hull; never compiled).
 #   cmake -DSOURCE_DIR=<project root> -DWORK_DIR=<scratch folder> -P layer_check_test.cmake
 cmake_minimum_required(VERSION 3.23)
 set(fixture ${SOURCE_DIR}/tests/layers/fixture)
-set(script ${SOURCE_DIR}/cmake/check_layers.cmake)
+set(script ${SOURCE_DIR}/tools/cmake/check_layers.cmake)
 file(MAKE_DIRECTORY ${WORK_DIR})
 
 # Writes a manifest as mvflow_check_layers does: model, flow (links model), hull (links model).

@@ -1,4 +1,4 @@
-# cmake -DMANIFEST=<file> -P cmake/check_layers.cmake: the layer check (cmake/MvflowLayers.cmake)
+# cmake -DMANIFEST=<file> -P tools/cmake/check_layers.cmake: the layer check (tools/cmake/MvflowLayers.cmake)
 # on the targets and files a manifest lists. The build runs it with the manifest that configuring
 # wrote; tests/layers runs it on a planted violation.
 cmake_minimum_required(VERSION 3.23)

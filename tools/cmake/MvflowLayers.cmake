@@ -14,7 +14,7 @@
 #     After every target is defined: checks the layers and their clients and sets up the
 #     build-time check.
 #   mvflow_check_layer_files(TARGET t OWN folder ALLOWED folders... KNOWN folders... ROOT dir FILES f...)
-#     The rule itself, without targets (also runs in script mode: cmake/check_layers.cmake).
+#     The rule itself, without targets (also runs in script mode: tools/cmake/check_layers.cmake).
 #     Returns the violations, one per entry, in MVFLOW_LAYER_VIOLATIONS (parent scope).
 
 set(MVFLOW_LAYERS_DIR ${CMAKE_CURRENT_LIST_DIR})
@@ -60,7 +60,7 @@ function(mvflow_report_layer_violations violations)
     list(LENGTH violations n)
     list(JOIN violations "\n  " text)
     message(FATAL_ERROR "layer check: ${n} violation(s):\n  ${text}\n"
-      "(a file may include its own folder and the layer folders its target links; see cmake/MvflowLayers.cmake)")
+      "(a file may include its own folder and the layer folders its target links; see tools/cmake/MvflowLayers.cmake)")
   endif()
 endfunction()
 
@@ -142,7 +142,7 @@ function(mvflow_check_layers)
     get_target_property(folder ${layer} MVFLOW_LAYER_FOLDER)
     list(APPEND known ${folder})
   endforeach()
-  set(manifest "# Written by mvflow_check_layers (cmake/MvflowLayers.cmake) at configure time.\n")
+  set(manifest "# Written by mvflow_check_layers (tools/cmake/MvflowLayers.cmake) at configure time.\n")
   string(APPEND manifest "set(MVFLOW_LAYER_ROOT \"${PROJECT_SOURCE_DIR}\")\nset(MVFLOW_LAYER_KNOWN \"${known}\")\n")
   set(all_violations)
   set(all_files)
