@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <unistd.h>
@@ -53,6 +54,26 @@ void expect_clean_refusal(Read&& read) {
   } catch (const InputError&) {
   } catch (const IoError&) {
   }
+}
+
+//! A model of two files (COLMAP's cameras and images): the input's first byte picks the file the
+//! rest becomes (even: \p first_name, odd: \p second_name); the other is the valid file that
+//! \p write_model puts in the same folder (once per folder). Then \p read_model reads the folder.
+inline void fuzz_two_file_model(const std::uint8_t* data, std::size_t size, const char* first_name,
+                                const char* second_name,
+                                const std::function<void(const std::filesystem::path&)>& write_model,
+                                const std::function<void(const std::filesystem::path&)>& read_model) {
+  if (size == 0) return;
+  const bool second = data[0] % 2 == 1;
+  static const std::filesystem::path folders[2] = {work_folder() / "first", work_folder() / "second"};
+  static bool written[2] = {false, false};
+  const std::filesystem::path& folder = folders[second];
+  if (!written[second]) {
+    write_model(folder);
+    written[second] = true;
+  }
+  write_input(second ? second_name : first_name, data + 1, size - 1, folder);
+  expect_clean_refusal([&] { read_model(folder); });
 }
 
 }  // namespace mvflow::fuzz
