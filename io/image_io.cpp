@@ -12,6 +12,7 @@
 
 #include "engine/model/error.h"
 #include "io/atomic_write.h"
+#include "io/little_endian.h"
 
 namespace mvflow::io {
 
@@ -77,24 +78,19 @@ std::optional<HeaderSize> jpeg_size(std::istream& in) {
   return std::nullopt;
 }
 
-std::uint32_t little_endian_32(const unsigned char* p) {
-  return std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) | (std::uint32_t{p[3]} << 24);
-}
-
 // BMP: the info header's width and height (signed; a negative height is a top-down image) follow
 // the 14-byte file header; the old 12-byte core header has 16-bit ones.
 std::optional<HeaderSize> bmp_size(std::istream& in) {
   std::array<unsigned char, 26> header{};
   if (!in.read(reinterpret_cast<char*>(header.data()), header.size())) return std::nullopt;
   if (header[0] != 'B' || header[1] != 'M') return std::nullopt;
-  if (little_endian_32(&header[14]) == 12)
-    return HeaderSize{std::uint32_t{header[18]} | (std::uint32_t{header[19]} << 8),
-                      std::uint32_t{header[20]} | (std::uint32_t{header[21]} << 8)};
-  const auto magnitude = [](std::uint32_t value) {
-    const auto signed_value = static_cast<std::int64_t>(static_cast<std::int32_t>(value));
-    return static_cast<std::uint32_t>(signed_value < 0 ? -signed_value : signed_value);
+  if (decode_little_endian<std::uint32_t>(&header[14]) == 12)
+    return HeaderSize{decode_little_endian<std::uint16_t>(&header[18]), decode_little_endian<std::uint16_t>(&header[20])};
+  const auto magnitude = [](const unsigned char* p) {
+    const std::int64_t value = decode_little_endian<std::int32_t>(p);
+    return static_cast<std::uint32_t>(value < 0 ? -value : value);
   };
-  return HeaderSize{magnitude(little_endian_32(&header[18])), magnitude(little_endian_32(&header[22]))};
+  return HeaderSize{magnitude(&header[18]), magnitude(&header[22])};
 }
 
 // PNM (P1..P6): magic, then width and height as decimal numbers between whitespace and comments.
@@ -126,7 +122,7 @@ std::optional<HeaderSize> tiff_size(std::istream& in) {
   const auto u16 = [little](const unsigned char* p) {
     return static_cast<std::uint32_t>(little ? p[0] | (p[1] << 8) : (p[0] << 8) | p[1]);
   };
-  const auto u32 = [little](const unsigned char* p) { return little ? little_endian_32(p) : big_endian_32(p); };
+  const auto u32 = [little](const unsigned char* p) { return little ? decode_little_endian<std::uint32_t>(p) : big_endian_32(p); };
   in.seekg(u32(&header[4]));
   unsigned char count_bytes[2];
   if (!in.read(reinterpret_cast<char*>(count_bytes), 2)) return std::nullopt;
