@@ -4,12 +4,10 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
-#include <cstdlib>
 #include <iostream>
 #include <string>
 
 #include "engine/model/error.h"
-#include "io/image_io.h"
 #include "stages/flow/photo_kernel.h"
 #include "tools/commands.h"
 
