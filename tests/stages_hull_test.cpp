@@ -23,7 +23,7 @@
 #include "stages/hull/mesh_cleanup.h"
 #include "stages/hull/neck_cutting.h"
 #include "stages/hull/scalar_grid.h"
-#include "stages/hull/silhouette_holes.h"
+#include "stages/flow/silhouette_holes.h"
 #include "stages/synth/synth_scene.h"
 #include "stages/hull/visual_hull.h"
 #include "test_support.h"

@@ -20,7 +20,7 @@
 #include "stages/hull/hull_mesh.h"
 #include "stages/hull/mesh_cleanup.h"
 #include "stages/flow/silhouette.h"
-#include "stages/hull/silhouette_holes.h"
+#include "stages/flow/silhouette_holes.h"
 #include "tools/commands.h"
 
 namespace mvflow::cli {

@@ -218,8 +218,24 @@ std::vector<RefineOptionEntry> make_table() {
                           "Keep the surface inside the visual hull of the used views' silhouettes (photographs on a "
                           "dark background)",
                           [](auto& o) -> auto& { return o.keep_inside_silhouettes; }, true));
+  t.push_back(choice("--fit-silhouettes", "fit_silhouettes",
+                     "Move the surface's rims (normal perpendicular to a view's ray, unoccluded) toward that view's "
+                     "silhouette boundary, past a dead zone: on, off, or auto (on when every view's border is dark, "
+                     "i.e. a background the threshold separates; thesis preset: off)",
+                     {{"off", RimFit::Off}, {"on", RimFit::On}, {"auto", RimFit::Auto}},
+                     [](auto& o) -> auto& { return o.rims.fit; }));
+  t.push_back(value("--rim-angle", "rim_angle_degrees",
+                    "--fit-silhouettes on: a vertex is a rim of a view within this angle of 90° between its normal "
+                    "and the view's ray (degrees)",
+                    [](auto& o) -> auto& { return o.rims.rim_angle_degrees; }, CLI::Range(0.001, 89.999)));
+  t.push_back(value("--rim-dead-zone", "rim_dead_zone_pixels",
+                    "--fit-silhouettes on: boundaries nearer than this many pixels are left to the photo consistency",
+                    [](auto& o) -> auto& { return o.rims.dead_zone_pixels; }, CLI::Range(0.0, 63.0)));
+  t.push_back(value("--rim-step", "rim_step",
+                    "--fit-silhouettes on: the fraction of the distance to the boundary moved per iteration",
+                    [](auto& o) -> auto& { return o.rims.step; }, CLI::Range(0.001, 1.0)));
   t.push_back(value("--silhouette-threshold", "silhouette_threshold",
-                    "Silhouettes for --keep-inside-silhouettes: largest channel above this (on [0,1])",
+                    "Silhouettes for --keep-inside-silhouettes and --fit-silhouettes: largest channel above this (on [0,1])",
                     [](auto& o) -> auto& { return o.silhouettes.threshold; }));
   t.push_back(value("--silhouette-dilate", "silhouette_dilate", "... dilated by this many pixels",
                     [](auto& o) -> auto& { return o.silhouettes.dilate; }));

@@ -12,10 +12,10 @@ namespace mvflow {
 
 //! The timed stages of an iteration (SPEC §7). For the flow graph each entry is the summed
 //! time of that stage's nodes over all blocks (CPU seconds); for the sequential path it is wall time.
-enum class Stage : int { Refinement, Refit, Geometry, Visibility, PhotoGradient, Cfl, Move, Smoothing, Regularization };
-inline constexpr std::size_t kStageCount = 9;
+enum class Stage : int { Refinement, Refit, Geometry, Visibility, PhotoGradient, Cfl, Move, Smoothing, Regularization, Rims };
+inline constexpr std::size_t kStageCount = 10;
 inline constexpr std::array<const char*, kStageCount> kStageNames{
-    "refinement", "refit", "geometry", "visibility", "photo_gradient", "cfl", "move", "smoothing", "regularization"};
+    "refinement", "refit", "geometry", "visibility", "photo_gradient", "cfl", "move", "smoothing", "regularization", "silhouette_rims"};
 
 struct IterationReport {
   int iteration = 0;                  //!< 1-based

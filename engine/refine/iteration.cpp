@@ -12,6 +12,7 @@
 #include "stages/flow/normals.h"
 #include "stages/flow/photo_robust.h"
 #include "stages/flow/regularization.h"
+#include "stages/flow/silhouette_rims.h"
 #include "stages/flow/smoothing.h"
 #include "stages/flow/unobserved_speed.h"
 #include "stages/flow/visibility.h"
@@ -219,7 +220,14 @@ void IterationData::commit(std::size_t block) {
   run_block(*this, block, nullptr, [&] { commit_positions(mesh, blocks[block], new_positions, inside); });
 }
 
-IterationPhases iteration_phases(const RefineOptions& options) {
+void IterationData::fit_rims(std::size_t block) {
+  run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Rims)], [&] {
+    fit_silhouette_rims(mesh, blocks[block], *rim_views, *rim_masks, surface.get(), mean_edge, options.rims, fields,
+                        new_positions);
+  });
+}
+
+IterationPhases iteration_phases(const RefineOptions& options, bool rims) {
   IterationPhases schedule{
       .pipeline = {&IterationData::geometry, &IterationData::visibility, &IterationData::photo_speed}, .phases = {}};
   schedule.phases.push_back(&IterationData::move);
@@ -235,11 +243,17 @@ IterationPhases iteration_phases(const RefineOptions& options) {
     schedule.phases.push_back(&IterationData::regularize);
     schedule.phases.push_back(&IterationData::commit);
   }
+  // Last, with the normals the regularization computed: the rims correct what the flow and the
+  // smoothing did to the outline.
+  if (rims) {
+    schedule.phases.push_back(&IterationData::fit_rims);
+    schedule.phases.push_back(&IterationData::commit);
+  }
   return schedule;
 }
 
 void run_iteration_sequential(IterationData& data) {
-  const IterationPhases schedule = iteration_phases(data.options);
+  const IterationPhases schedule = iteration_phases(data.options, data.rim_masks != nullptr);
   const std::size_t n = data.blocks.size();
   data.refit();
   for (BlockKernel kernel : schedule.pipeline)

@@ -22,6 +22,7 @@
 #include "stages/flow/photo_gradient.h"
 #include "stages/flow/photo_views.h"
 #include "stages/flow/silhouette_constraint.h"
+#include "stages/flow/silhouette.h"
 #include "stages/flow/speed.h"
 
 namespace mvflow {
@@ -40,6 +41,10 @@ struct IterationData {
   std::function<void(std::size_t block)> on_block;
   PhotoGradientStage photo;
   const SilhouetteConstraint* inside = nullptr;  //!< keeps the surface in the visual hull when set
+  //! One silhouette per view (full resolution) when the rims are fitted (fits_rims): the
+  //! fit_rims phase reads them; otherwise null.
+  const std::vector<Mask>* rim_masks = nullptr;
+  const std::vector<PhotoView>* rim_views = nullptr;  //!< the full-resolution views of rim_masks
 
   std::unique_ptr<SurfaceQuery> surface;  //!< rebuilt when the topology changes, refitted otherwise
   VertexFields fields;
@@ -99,6 +104,7 @@ struct IterationData {
   void inflate(std::size_t block);     //!< new position of Taubin's second step (taubin_pass_band > 0)
   void regularize(std::size_t block);  //!< normals at the current positions, then regularization
   void commit(std::size_t block);      //!< new positions into the mesh
+  void fit_rims(std::size_t block);    //!< new position of the silhouette rims (with rim_masks)
 };
 
 //! A per-block kernel of IterationData.
@@ -119,8 +125,9 @@ struct IterationPhases {
 };
 
 //! The phases of an iteration under \p options: move; per smoothing step smooth, commit (and
-//! inflate, commit with a Taubin pass band); per regularization step regularize, commit.
-IterationPhases iteration_phases(const RefineOptions& options);
+//! inflate, commit with a Taubin pass band); per regularization step regularize, commit; with
+//! \p rims (silhouette rims fitted), fit_rims, commit.
+IterationPhases iteration_phases(const RefineOptions& options, bool rims);
 
 //! Runs one iteration's kernels in a plain loop on the calling thread, phase by phase and block by
 //! block (iteration_phases): the reference path for determinism tests and benchmarks.

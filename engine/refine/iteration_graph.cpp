@@ -12,7 +12,7 @@ IterationGraph::Node* IterationGraph::add(std::function<void()> body) {
 }
 
 IterationGraph::IterationGraph(IterationData& data) : n_blocks_(data.blocks.size()) {
-  const IterationPhases schedule = iteration_phases(data.options);
+  const IterationPhases schedule = iteration_phases(data.options, data.rim_masks != nullptr);
   const std::size_t n = n_blocks_;
   start_ = add([&data] { data.refit(); });
 

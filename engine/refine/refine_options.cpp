@@ -25,6 +25,8 @@ void RefineOptions::check() const {
   require(block_size >= 1, "block size >= 1");
   require(image_levels >= 0 && image_levels <= 4, "image levels 0..4");
   require(silhouettes.check(), "silhouettes (threshold in [0, 1), dilation >= 0)");
+  require(rims.check(), "silhouette rims (angle in (0, 90), dead zone >= 0 below the search distance <= 64 pixels, "
+                        "step in (0, 1], ray offset >= 0, holes in [0, 1])");
   require(photo.photo.half_patch == visibility.half_patch, "the visibility patch must equal the photo patch");
   for (int view : excluded_views) require(view >= 0, "excluded views are 0-based indices");
 }
@@ -48,6 +50,7 @@ RefineOptions thesis_preset() {
   options.smoothing.taubin_pass_band = 0.0;
   options.refinement_schedule = RefinementSchedule::EveryIteration;
   options.stopping.test = ConvergenceTest::EachLookback;
+  options.rims.fit = RimFit::Off;
   return options;
 }
 

@@ -12,6 +12,7 @@
 #include "stages/flow/regularization.h"
 #include "stages/topology/remeshing.h"
 #include "stages/flow/silhouette.h"
+#include "stages/flow/silhouette_rims.h"
 #include "stages/flow/smoothing.h"
 #include "stages/flow/speed.h"
 #include "stages/flow/stopping.h"
@@ -94,6 +95,10 @@ struct RefineOptions {
   //! How the silhouettes are thresholded; 0.19 (Middlebury) with a 3-pixel dilation so that
   //! calibration error does not cut into the object.
   SilhouetteOptions silhouettes{.threshold = 0.19, .dilate = 3};
+  //! Fit the surface's rims to the silhouettes (stages/flow/silhouette_rims.h), thresholded at
+  //! silhouettes.threshold without the dilation: by default when every view's border is dark
+  //! (README, "Defaults and differences"); off in the thesis preset.
+  SilhouetteRimOptions rims;
 
   //! \throw InputError naming the first option out of range.
   void check() const;

@@ -25,6 +25,7 @@
 #include "stages/topology/remeshing.h"
 #include "stages/topology/self_intersections.h"
 #include "stages/flow/silhouette_constraint.h"
+#include "stages/flow/silhouette_rims.h"
 #include "stages/flow/smoothing.h"
 #include "stages/flow/unobserved_displacement.h"
 #include "stages/topology/untangling.h"
@@ -125,6 +126,11 @@ class Refinement {
       inside_.emplace(full_views_, threshold_silhouettes(full_views_, options.silhouettes));
       data_.inside = &*inside_;
     }
+    if (fits_rims(full_views_, options.silhouettes.threshold, options.rims)) {
+      rim_masks_ = rim_silhouettes(full_views_, options.silhouettes, options.rims);
+      data_.rim_masks = &rim_masks_;
+      data_.rim_views = &full_views_;
+    }
   }
 
   RefineResult run() {
@@ -134,6 +140,9 @@ class Refinement {
     summary.initial_vertices = mesh_.n_vertices();
     summary.initial_faces = mesh_.n_faces();
     progress(0, RefineStage::Preparing);
+    if (control_.logger && data_.rim_masks)
+      control_.logger->info("fitting the rims to the silhouettes (threshold {}){}", options_.silhouettes.threshold,
+                            options_.rims.fit == RimFit::Auto ? ": every view's border is dark" : "");
     prepare();
     summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, options_).sum_g_per_vertex;
 
@@ -371,6 +380,7 @@ class Refinement {
   std::vector<Eigen::Vector3d> reference_;
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
   std::optional<SilhouetteConstraint> inside_;
+  std::vector<Mask> rim_masks_;  //!< one per view of full_views_ with options.rims.enabled
 };
 
 }  // namespace

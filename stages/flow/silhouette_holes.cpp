@@ -1,4 +1,4 @@
-#include "stages/hull/silhouette_holes.h"
+#include "stages/flow/silhouette_holes.h"
 
 #include <cstdint>
 
