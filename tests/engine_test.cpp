@@ -348,6 +348,16 @@ TEST(Refiner, BadInputIsAFailedStatusNotAnException) {
   const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
   EXPECT_EQ(result.summary.status, RefineStatus::Failed);
   EXPECT_NE(result.summary.message.find("excluded view 42"), std::string::npos) << result.summary.message;
+  // Every view but one excluded: refused before any image is decoded, naming the counts.
+  options.excluded_views.clear();
+  for (int v = 1; v < static_cast<int>(s.scene.size()); ++v) options.excluded_views.push_back(v);
+  const RefineResult one_left = refine_mesh(s.scene, s.initial, options, {});
+  EXPECT_EQ(one_left.summary.status, RefineStatus::Failed);
+  EXPECT_NE(one_left.summary.message.find("fewer than 2 views are left to refine with (" +
+                                          std::to_string(s.scene.size()) + " views, " +
+                                          std::to_string(s.scene.size() - 1) + " excluded)"),
+            std::string::npos)
+      << one_left.summary.message;
   options.excluded_views = {};
   options.cfl = -1;
   EXPECT_EQ(refine_mesh(s.scene, s.initial, options, {}).summary.status, RefineStatus::Failed);

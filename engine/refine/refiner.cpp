@@ -41,19 +41,26 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// The views the refinement may use, in scene order without the excluded ones.
+// The views the refinement may use, in scene order without the excluded ones. The exclusions are
+// checked before any image is decoded; errors name the scene's folder (when it has one).
 std::vector<PhotoView> usable_views(const Scene& scene, const std::vector<int>& excluded) {
+  const auto refuse = [&](const std::string& what) {
+    if (scene.folder.empty()) throw InputError(what);
+    throw InputError(scene.folder, 0, what);
+  };
+  for (int view : excluded)
+    if (view >= static_cast<int>(scene.size()))
+      refuse("excluded view " + std::to_string(view) + " does not exist (the scene has " +
+             std::to_string(scene.size()) + " views)");
+  std::size_t left = 0;
+  for (std::size_t i = 0; i < scene.size(); ++i)
+    if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) == excluded.end()) ++left;
+  if (left < 2) refuse("fewer than 2 views are left to refine with (" + std::to_string(scene.size()) + " views, " +
+                       std::to_string(scene.size() - left) + " excluded)");
   std::vector<PhotoView> all = make_photo_views(scene);
   std::vector<PhotoView> kept;
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) != excluded.end()) continue;
-    kept.push_back(all[i]);
-  }
-  for (int view : excluded)
-    if (view >= static_cast<int>(all.size()))
-      throw InputError("excluded view " + std::to_string(view) + " does not exist (the scene has " +
-                       std::to_string(all.size()) + " views)");
-  if (kept.size() < 2) throw InputError("fewer than 2 views are left to refine with");
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) == excluded.end()) kept.push_back(all[i]);
   return kept;
 }
 
