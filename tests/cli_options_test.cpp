@@ -1,11 +1,13 @@
 // The refine options' table (tools/refine_option_table.h): every entry's flag sets the field its
-// report key shows, the preset stays where no flag is given, and nothing is declared twice.
+// report key shows, the preset stays where no flag is given, nothing is declared twice, and a value
+// out of range is refused by the stages' own checks under its flag.
 
 #include <gtest/gtest.h>
 
 #include <map>
 #include <set>
 
+#include "engine/model/option_check.h"
 #include "tools/refine_option_table.h"
 
 namespace mvflow::cli {
@@ -115,6 +117,68 @@ TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
         {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}}) {
     EXPECT_THROW(options_after(bad), CLI::ParseError) << bad[0] << " " << bad[1];
   }
+}
+
+// The message a refused command line gives ("" if it is accepted).
+std::string refusal(const std::vector<std::string>& arguments) {
+  try {
+    options_after(arguments);
+  } catch (const CLI::ParseError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RefineOptionTable, AValueOutOfRangeIsRefusedNamingTheFlagTheFieldTheValueAndTheValidValues) {
+  EXPECT_EQ(refusal({"--cfl", "20"}), "--cfl: option cfl = 20 is out of range: expected (0, 10]");
+  EXPECT_EQ(refusal({"--smoothing", "1.5"}),
+            "--smoothing: option smoothing.lambda_dt = 1.5 is out of range: expected (0, 1)");
+  EXPECT_EQ(refusal({"--max-view-angle", "200"}),
+            "--max-view-angle: option visibility.max_angle_degrees = 200 is out of range: expected (0, 90]");
+  EXPECT_EQ(refusal({"--patch", "9"}), "--patch: option photo.photo.half_patch = 9 is out of range: expected [1, 7]");
+  EXPECT_EQ(refusal({"--max-iterations", "5"}),
+            "--max-iterations: option stopping.max_iterations = 5 is out of range: expected >= min_iterations (10)");
+}
+
+TEST(RefineOptionTable, RangesAreCheckedOnceEveryFlagIsApplied) {
+  // λ·dt = 0.95 needs a Taubin pass band below the default's (μ < 1); with 0 it is valid.
+  EXPECT_EQ(refusal({"--smoothing", "0.95", "--taubin-pass-band", "0"}), "");
+  EXPECT_EQ(refusal({"--smoothing", "0.95"}).rfind("--taubin-pass-band: option smoothing.taubin_pass_band = 0.1", 0), 0u);
+  EXPECT_EQ(refusal({"--min-iterations", "300", "--max-iterations", "400"}), "");
+}
+
+TEST(RefineOptionTable, HelpQuotesTheValidValuesOfTheStagesChecks) {
+  CLI::App command;
+  add_refine_options(command);
+  EXPECT_NE(command.get_option("--cfl")->get_description().find("(valid: (0, 10])"), std::string::npos);
+  EXPECT_NE(command.get_option("--patch")->get_description().find("(valid: [1, 7])"), std::string::npos);
+  EXPECT_NE(command.get_option("--sg-k")->get_description().find("(valid: an even number >= 2)"), std::string::npos);
+  for (const RefineOptionEntry& entry : refine_option_table()) {
+    if (!entry.members.empty() && entry.flag != "--exclude-views") {
+      EXPECT_NE(command.get_option(entry.flag)->get_description().find("(valid: "), std::string::npos) << entry.flag;
+    }
+  }
+}
+
+TEST(RefineOptions, CheckNamesTheFirstFieldOutOfRangeByItsPath) {
+  RefineOptions options = default_preset();
+  EXPECT_NO_THROW(options.check());
+  options.smoothing.lambda_dt = 2;
+  try {
+    options.check();
+    FAIL() << "smoothing.lambda_dt = 2 was accepted";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.option(), "smoothing.lambda_dt");
+    EXPECT_EQ(e.value(), "2");
+    EXPECT_EQ(e.expected(), "(0, 1)");
+    EXPECT_STREQ(e.what(), "option smoothing.lambda_dt = 2 is out of range: expected (0, 1)");
+  }
+  options = default_preset();
+  options.visibility.half_patch = 3;  // the photo patch stays 2
+  EXPECT_THROW(options.check(), OptionError);
+  options = default_preset();
+  options.excluded_views = {2, -1};
+  EXPECT_THROW(options.check(), InputError);  // OptionError is an InputError
 }
 
 }  // namespace

@@ -13,9 +13,10 @@
 
 #include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
-#include "stages/topology/adaptive_refinement.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/curvature.h"
 #include "stages/flow/normals.h"
+#include "stages/topology/adaptive_refinement.h"
 #include "stages_meshes.h"
 #include "test_support.h"
 
@@ -110,13 +111,13 @@ constexpr AdaptiveRefinementOptions kEveryRefinement{.min_growth = 0.0};
 
 TEST(AdaptiveRefinementOptions, DefaultsAreTheThesisValuesAndValid) {
   const AdaptiveRefinementOptions options;
-  EXPECT_TRUE(options.check());
+  EXPECT_NO_THROW(options.check());
   EXPECT_EQ(options.curvature_factor, 0.5);     // tolerance e_S / 2, thesis B.7
   EXPECT_EQ(options.min_edge_relative, 1e-3);   // thesis B.4's 1e-3, relative (SPEC §9)
   EXPECT_EQ(options.min_growth, 0.1);           // not the thesis's (0): README, "Defaults and differences"
-  EXPECT_FALSE((AdaptiveRefinementOptions{.curvature_factor = 0.0}.check()));
-  EXPECT_FALSE((AdaptiveRefinementOptions{.min_edge_relative = -1.0, .min_growth = 0.0}.check()));
-  EXPECT_FALSE((AdaptiveRefinementOptions{.curvature_factor = NAN}.check()));
+  EXPECT_THROW((AdaptiveRefinementOptions{.curvature_factor = 0.0}).check(), OptionError);
+  EXPECT_THROW((AdaptiveRefinementOptions{.min_edge_relative = -1.0, .min_growth = 0.0}).check(), OptionError);
+  EXPECT_THROW((AdaptiveRefinementOptions{.curvature_factor = NAN}).check(), OptionError);
   TriMesh mesh = test::icosphere(1.0, 1);
   const VertexFields fields = curvature_of(mesh);
   EXPECT_THROW(refine_adaptively(mesh, fields, 0.0), Error);
@@ -228,7 +229,7 @@ TEST_F(BumpedSphere, MinimumGrowthDeclinesASmallRefinementAndChangesNothing) {
   EXPECT_EQ(triangles_of(accepted), triangles_of(reference));
   EXPECT_EQ(positions_of(accepted), positions_of(reference));
 
-  for (const double bad : {-0.1, 1.0, std::nan("")}) EXPECT_FALSE(AdaptiveRefinementOptions{.min_growth = bad}.check()) << bad;
+  for (const double bad : {-0.1, 1.0, std::nan("")}) EXPECT_THROW(AdaptiveRefinementOptions{.min_growth = bad}.check(), OptionError) << bad;
 }
 
 TEST_F(BumpedSphere, MinimumEdgeBlocksRefinement) {

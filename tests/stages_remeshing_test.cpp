@@ -12,6 +12,7 @@
 
 #include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
+#include "engine/model/option_check.h"
 #include "stages/topology/remeshing.h"
 #include "stages/topology/self_intersections.h"  // the input check only
 #include "stages_meshes.h"
@@ -112,12 +113,12 @@ void expect_contiguous_and_finite(const TriMesh& mesh) {
 
 TEST(RemeshingOptions, DefaultsAreTheThesisValuesAndValid) {
   const RemeshingOptions options;
-  EXPECT_TRUE(options.check());
+  EXPECT_NO_THROW(options.check());
   EXPECT_EQ(options.split_factor, 2.0);     // b_u = 2 e_S, thesis B.7
   EXPECT_EQ(options.collapse_factor, 0.8);  // b_l = 4/5 e_S, thesis B.7
-  EXPECT_FALSE((RemeshingOptions{.split_factor = 1.5, .collapse_factor = 0.8}.check()));
-  EXPECT_FALSE((RemeshingOptions{.split_factor = 2.0, .collapse_factor = 0.0}.check()));
-  EXPECT_FALSE((RemeshingOptions{.split_factor = NAN, .collapse_factor = 0.8}.check()));
+  EXPECT_THROW((RemeshingOptions{.split_factor = 1.5, .collapse_factor = 0.8}).check(), OptionError);
+  EXPECT_THROW((RemeshingOptions{.split_factor = 2.0, .collapse_factor = 0.0}).check(), OptionError);
+  EXPECT_THROW((RemeshingOptions{.split_factor = NAN, .collapse_factor = 0.8}).check(), OptionError);
   TriMesh mesh = test::icosphere(1.0, 1);
   EXPECT_THROW(remesh_edges(mesh, 0.0), Error);
   EXPECT_THROW(remesh_edges(mesh, INFINITY), Error);

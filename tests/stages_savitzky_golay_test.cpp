@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/savitzky_golay.h"
 
 namespace mvflow {
@@ -142,15 +143,15 @@ TEST(SavitzkyGolay, DifferentiatesPolynomialsUpToTheOrderExactly) {
 
 TEST(SavitzkyGolay, OptionsAndArguments) {
   const SavitzkyGolayOptions options;
-  EXPECT_TRUE(options.check());
+  EXPECT_NO_THROW(options.check());
   EXPECT_EQ(options.k, 20);
   EXPECT_EQ(options.order, 4);
   EXPECT_EQ(options.half_window(), 10);
   EXPECT_DOUBLE_EQ(options.sample_spacing(0.4), 0.01);             // e_min / 40
   EXPECT_DOUBLE_EQ(options.k * options.sample_spacing(0.4), 0.2);  // Δ = e_min / 2
-  EXPECT_FALSE((SavitzkyGolayOptions{.k = 21}).check());
-  EXPECT_FALSE((SavitzkyGolayOptions{.k = 2, .order = 4}).check());
-  EXPECT_FALSE((SavitzkyGolayOptions{.order = 0}).check());
+  EXPECT_THROW((SavitzkyGolayOptions{.k = 21}).check(), OptionError);
+  EXPECT_THROW((SavitzkyGolayOptions{.k = 2, .order = 4}).check(), OptionError);
+  EXPECT_THROW((SavitzkyGolayOptions{.order = 0}).check(), OptionError);
   EXPECT_THROW(savitzky_golay_derivative_coefficients(0, 1), Error);
   EXPECT_THROW(savitzky_golay_derivative_coefficients(2, 5), Error);
   EXPECT_THROW(savitzky_golay_derivative_coefficients(3, 0), Error);

@@ -10,6 +10,7 @@
 
 #include "engine/model/camera.h"
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/silhouette.h"
 #include "engine/model/primitives.h"
 #include "engine/model/surface_query.h"
@@ -181,7 +182,7 @@ TEST(SilhouetteRims, LeaveWhatIsNoRimNearTheBoundaryOrHidden) {
   EXPECT_GT(rim_move(rim.point, rim.normal, s.views, masks, &aside, 0.01, whole_step(0.0)), 0.0);
   SilhouetteRimOptions bad = whole_step(0.0);
   bad.search_pixels = 0.0;
-  EXPECT_FALSE(bad.check());
+  EXPECT_THROW(bad.check(), OptionError);
 }
 
 TEST(SilhouetteRims, RunByDefaultOnlyWhenEveryViewsBorderIsDark) {

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/commit.h"
 #include "stages/flow/normals.h"
 #include "stages/flow/regularization.h"
@@ -22,23 +23,23 @@ using test::position;
 
 TEST(SmoothingOptions, DefaultsAreValidAndFollowTheSpec) {
   const SmoothingOptions options;
-  EXPECT_TRUE(options.check());
+  EXPECT_NO_THROW(options.check());
   EXPECT_EQ(options.lambda_dt, 0.1);
   EXPECT_EQ(options.steps, 1);
-  EXPECT_FALSE((SmoothingOptions{.lambda_dt = 0.0}).check());
-  EXPECT_FALSE((SmoothingOptions{.lambda_dt = 1.0}).check());
-  EXPECT_FALSE((SmoothingOptions{.steps = -1}).check());
+  EXPECT_THROW((SmoothingOptions{.lambda_dt = 0.0}).check(), OptionError);
+  EXPECT_THROW((SmoothingOptions{.lambda_dt = 1.0}).check(), OptionError);
+  EXPECT_THROW((SmoothingOptions{.steps = -1}).check(), OptionError);
   TriMesh mesh = icosphere(1.0, 1);
   EXPECT_THROW(apply_smoothing(mesh, {.lambda_dt = 2.0}), Error);
 }
 
 TEST(RegularizationOptions, DefaultsAreValidAndFollowTheSpec) {
   const RegularizationOptions options;
-  EXPECT_TRUE(options.check());
+  EXPECT_NO_THROW(options.check());
   EXPECT_EQ(options.strength, 0.5);
   EXPECT_EQ(options.steps, 1);
-  EXPECT_FALSE((RegularizationOptions{.strength = 0.0}).check());
-  EXPECT_FALSE((RegularizationOptions{.strength = 1.5}).check());
+  EXPECT_THROW((RegularizationOptions{.strength = 0.0}).check(), OptionError);
+  EXPECT_THROW((RegularizationOptions{.strength = 1.5}).check(), OptionError);
 }
 
 // Standard deviation of |P| over the vertices: the noise left after removing the mean radius.
@@ -98,7 +99,7 @@ TEST(Smoothing, TaubinPairsRemoveNoiseWithoutShrinking) {
   const SmoothingOptions plain{.lambda_dt = 0.1, .steps = 10, .taubin_pass_band = 0.0};
   const SmoothingOptions taubin{.lambda_dt = 0.1, .steps = 10, .taubin_pass_band = 0.1};
   EXPECT_DOUBLE_EQ(taubin.taubin_mu(), 0.1 / (1 - 0.1 * 0.1));
-  ASSERT_TRUE(taubin.check());
+  ASSERT_NO_THROW(taubin.check());
   const auto mean_radius = [](const TriMesh& m) {
     double sum = 0.0;
     for (auto v : m.vertices()) sum += m.point(v).norm();
@@ -117,9 +118,9 @@ TEST(Smoothing, TaubinPairsRemoveNoiseWithoutShrinking) {
               shrink_plain, shrink_taubin, noise_before, noise_after);
   EXPECT_LT(shrink_taubin, 0.1 * shrink_plain);
   EXPECT_LT(noise_after, 0.95 * noise_before);  // measured 0.90: weaker than plain steps, but no shrink
-  EXPECT_FALSE((SmoothingOptions{.lambda_dt = 0.1, .taubin_pass_band = -0.1}.check()));
-  EXPECT_FALSE((SmoothingOptions{.lambda_dt = 0.9, .taubin_pass_band = 0.5}.check()));  // μ ≥ 1
-  EXPECT_FALSE((SmoothingOptions{.lambda_dt = 0.1, .taubin_pass_band = 20}.check()));  // μ < 0: a second shrink
+  EXPECT_THROW((SmoothingOptions{.lambda_dt = 0.1, .taubin_pass_band = -0.1}).check(), OptionError);
+  EXPECT_THROW((SmoothingOptions{.lambda_dt = 0.9, .taubin_pass_band = 0.5}).check(), OptionError);  // μ ≥ 1
+  EXPECT_THROW((SmoothingOptions{.lambda_dt = 0.1, .taubin_pass_band = 20}).check(), OptionError);  // μ < 0: a second shrink
 }
 
 TEST(Smoothing, KeepsBoundaryVerticesAndFlatInteriorsInTheirPlane) {

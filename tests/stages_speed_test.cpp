@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/speed.h"
 #include "stages_meshes.h"
 
@@ -33,9 +34,9 @@ VertexFields hand_made_fields() {
 }
 
 TEST(SpeedOptions, DefaultIsTheThesisInitialSpeed) {
-  EXPECT_TRUE(SpeedOptions{}.check());
+  EXPECT_NO_THROW(SpeedOptions{}.check());
   EXPECT_EQ(SpeedOptions{}.velocity, 0.001);
-  EXPECT_FALSE(SpeedOptions{.velocity = std::nan("")}.check());
+  EXPECT_THROW(SpeedOptions{.velocity = std::nan("")}.check(), OptionError);
 }
 
 TEST(Speed, FollowsTheFlowEquation) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/stopping.h"
 
 namespace mvflow {
@@ -33,16 +34,16 @@ std::pair<std::size_t, StopReason> run(const std::vector<double>& g, double move
 
 TEST(StoppingOptions, DefaultsFollowTheThesisButForTheTestTheBudgetAndTheStepTolerance) {
   const StoppingOptions o;
-  EXPECT_TRUE(o.check());
+  EXPECT_NO_THROW(o.check());
   EXPECT_EQ(o.test, ConvergenceTest::NoImprovement);
   EXPECT_EQ(o.epsilon_percent, 0.3);
   EXPECT_EQ(o.min_iterations, 10);
   EXPECT_EQ(o.max_iterations, 200);
   EXPECT_EQ(o.lookback, 5);
   EXPECT_EQ(o.median_move_tolerance, 0.001);
-  EXPECT_FALSE((StoppingOptions{.epsilon_percent = 0.0}).check());
-  EXPECT_FALSE((StoppingOptions{.min_iterations = 5}).check());  // needs lookback + 1
-  EXPECT_FALSE((StoppingOptions{.max_iterations = 9}).check());
+  EXPECT_THROW((StoppingOptions{.epsilon_percent = 0.0}).check(), OptionError);
+  EXPECT_THROW((StoppingOptions{.min_iterations = 5}).check(), OptionError);  // needs lookback + 1
+  EXPECT_THROW((StoppingOptions{.max_iterations = 9}).check(), OptionError);
   EXPECT_THROW(StoppingCriterion(StoppingOptions{.lookback = 0}), Error);
   EXPECT_STREQ(to_string(StopReason::Converged), "converged");
   EXPECT_STREQ(to_string(StopReason::StepSmall), "step-small");

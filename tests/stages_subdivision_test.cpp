@@ -13,6 +13,7 @@
 
 #include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
+#include "engine/model/option_check.h"
 #include "io/mesh_io.h"
 #include "stages/topology/subdivision.h"
 #include "stages_meshes.h"
@@ -109,15 +110,15 @@ bool identical(const TriMesh& a, const TriMesh& b) {
 
 TEST(SubdivisionOptions, DefaultsAreValidAndBadValuesRejected) {
   SubdivisionOptions options;
-  EXPECT_TRUE(options.check());
+  EXPECT_NO_THROW(options.check());
   EXPECT_EQ(options.scheme, Scheme::Loop);
   EXPECT_EQ(options.iterations, 1);
   EXPECT_EQ(options.sharp_angle_degrees, 30.0);
   options.iterations = -1;
-  EXPECT_FALSE(options.check());
+  EXPECT_THROW(options.check(), OptionError);
   options = {};
   options.sharp_angle_degrees = 181;
-  EXPECT_FALSE(options.check());
+  EXPECT_THROW(options.check(), OptionError);
   const TriMesh mesh = to_trimesh(test::octahedron());
   options.iterations = -1;
   EXPECT_THROW(subdivide(mesh, options), Error);

@@ -1,7 +1,11 @@
 #include "tools/refine_option_table.h"
 
+#include <algorithm>
+#include <limits>
 #include <type_traits>
 #include <utility>
+
+#include "engine/model/option_check.h"
 
 namespace mvflow::cli {
 
@@ -18,18 +22,43 @@ const RefineOptions& defaults() {
 template <typename Get>
 using FieldType = std::remove_cvref_t<decltype(std::declval<Get>()(std::declval<RefineOptions&>()))>;
 
-// A numeric (or other single-value) field set from the flag's value.
+// The valid values of \p member as RefineOptions::check states them ("(0, 10]"), found by
+// checking the default preset with a value no range admits (NaN, or the lowest integer) set by
+// \p spoil: each range is written once, in its stage's check(). Empty when that is accepted.
+std::string valid_values(const std::string& member, const std::function<void(RefineOptions&)>& spoil) {
+  RefineOptions probe = defaults();
+  spoil(probe);
+  try {
+    probe.check();
+  } catch (const OptionError& e) {
+    if (e.option() == member) return e.expected();
+  }
+  return "";
+}
+
+template <typename T>
+T outside_every_range() {
+  if constexpr (std::numeric_limits<T>::has_quiet_NaN) return std::numeric_limits<T>::quiet_NaN();
+  else return std::numeric_limits<T>::lowest();
+}
+
+// The help with the valid values appended, as --help shows it.
+std::string with_valid_values(const std::string& help, const std::string& valid) {
+  return valid.empty() ? help : help + " (valid: " + valid + ")";
+}
+
+// A numeric (or other single-value) field set from the flag's value; RefineOptions::check names
+// it \p member.
 template <typename Get>
-RefineOptionEntry value(std::string flag, std::string key, std::string help, Get get,
-                        std::optional<CLI::Validator> check = std::nullopt) {
+RefineOptionEntry value(std::string flag, std::string key, std::string member, std::string help, Get get) {
   using T = FieldType<Get>;
-  return {flag, key,
+  return {flag, key, {member},
           [=](CLI::App& command) {
-            CLI::Option* option = command.add_option(flag, help)
-                                      ->type_name(CLI::detail::type_name<T>())
-                                      ->default_str(CLI::detail::to_string(get(defaults())));
-            if (check) option->check(*check);
-            return option;
+            const std::string description =
+                with_valid_values(help, valid_values(member, [get](RefineOptions& o) { get(o) = outside_every_range<T>(); }));
+            return command.add_option(flag, description)
+                ->type_name(CLI::detail::type_name<T>())
+                ->default_str(CLI::detail::to_string(get(defaults())));
           },
           [=](const CLI::Option& given, RefineOptions& target) { get(target) = given.as<T>(); },
           [=](const RefineOptions& options) { return nlohmann::json(get(options)); }};
@@ -50,7 +79,7 @@ RefineOptionEntry choice(std::string flag, std::string key, std::string help,
   };
   std::vector<std::string> allowed;
   for (const auto& entry : names) allowed.push_back(entry.first);
-  return {flag, key,
+  return {flag, key, {},
           [=](CLI::App& command) {
             return command.add_option(flag, help)
                 ->type_name("TEXT")
@@ -76,7 +105,7 @@ RefineOptionEntry on_off(std::string flag, std::string key, std::string help, Ge
 // A flag without a value that sets a bool field to \p when_given.
 template <typename Get>
 RefineOptionEntry switch_flag(std::string flag, std::string key, std::string help, Get get, bool when_given) {
-  return {flag, key, [=](CLI::App& command) { return command.add_flag(flag, help); },
+  return {flag, key, {}, [=](CLI::App& command) { return command.add_flag(flag, help); },
           [=](const CLI::Option&, RefineOptions& target) { get(target) = when_given; },
           [=](const RefineOptions& options) { return nlohmann::json(get(options)); }};
 }
@@ -87,112 +116,114 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(choice("--engine", "engine", "graph (TBB flow graph) or sequential (reference loop, one thread)",
                      {{"graph", EngineKind::Graph}, {"sequential", EngineKind::Sequential}},
                      [](auto& o) -> auto& { return o.engine; }));
-  t.push_back(value("--block-size", "block_size", "Vertices per block (graph node)",
-                    [](auto& o) -> auto& { return o.block_size; }, CLI::PositiveNumber));
-  t.push_back(value("--velocity", "velocity", "Balloon velocity v of the speed g(v+H)",
+  t.push_back(value("--block-size", "block_size", "block_size", "Vertices per block (graph node)",
+                    [](auto& o) -> auto& { return o.block_size; }));
+  t.push_back(value("--velocity", "velocity", "speed.velocity", "Balloon velocity v of the speed g(v+H)",
                     [](auto& o) -> auto& { return o.speed.velocity; }));
-  t.push_back(value("--cfl", "cfl", "CFL factor of the time step", [](auto& o) -> auto& { return o.cfl; }));
-  t.push_back(value("--speed-quantile", "speed_quantile",
+  t.push_back(value("--cfl", "cfl", "cfl", "CFL factor of the time step", [](auto& o) -> auto& { return o.cfl; }));
+  t.push_back(value("--speed-quantile", "speed_quantile", "speed_quantile",
                     "Quantile of |F| that sets the time step (1 = max, the thesis); faster vertices move the CFL distance",
                     [](auto& o) -> auto& { return o.speed_quantile; }));
   // The patch sets the photo consistency's and the visibility's half size together.
-  t.push_back({"--patch", "patch",
+  t.push_back({"--patch", "patch", {"photo.photo.half_patch", "visibility.half_patch"},
                [](CLI::App& command) {
-                 return command.add_option("--patch", "Patch half size (2 = 5×5)")
+                 const std::string description =
+                     with_valid_values("Patch half size (2 = 5×5)", valid_values("photo.photo.half_patch", [](R& o) {
+                                         o.photo.photo.half_patch = o.visibility.half_patch = outside_every_range<int>();
+                                       }));
+                 return command.add_option("--patch", description)
                      ->type_name("INT")
-                     ->check(CLI::Range(1, 7))
                      ->default_str(std::to_string(defaults().photo.photo.half_patch));
                },
                [](const CLI::Option& given, R& target) {
                  target.photo.photo.half_patch = target.visibility.half_patch = given.as<int>();
                },
                [](const R& o) { return nlohmann::json(2 * o.photo.photo.half_patch + 1); }});
-  t.push_back(value("--sg-k", "savitzky_golay_k", "Savitzky–Golay k (window k+1 samples per axis)",
+  t.push_back(value("--sg-k", "savitzky_golay_k", "photo.savitzky_golay.k", "Savitzky–Golay k (window k+1 samples per axis)",
                     [](auto& o) -> auto& { return o.photo.savitzky_golay.k; }));
-  t.push_back(value("--sg-order", "savitzky_golay_order", "Savitzky–Golay polynomial order",
+  t.push_back(value("--sg-order", "savitzky_golay_order", "photo.savitzky_golay.order", "Savitzky–Golay polynomial order",
                     [](auto& o) -> auto& { return o.photo.savitzky_golay.order; }));
   t.push_back(choice("--curvature-area", "curvature_area",
                      "Area of the mean-curvature operator: mixed (Meyer et al.) or barycentric (the thesis)",
                      {{"mixed", CurvatureArea::Mixed}, {"barycentric", CurvatureArea::Barycentric}},
                      [](auto& o) -> auto& { return o.curvature.area; }));
-  t.push_back(value("--max-view-angle", "max_view_angle_degrees",
+  t.push_back(value("--max-view-angle", "max_view_angle_degrees", "visibility.max_angle_degrees",
                     "Views beyond this angle to the normal are not used (degrees)",
                     [](auto& o) -> auto& { return o.visibility.max_angle_degrees; }));
-  t.push_back(value("--max-views", "max_views",
+  t.push_back(value("--max-views", "max_views", "visibility.max_views",
                     "Keep only this many visible views per vertex, those closest to the normal (0 = all, else >= 2)",
-                    [](auto& o) -> auto& { return o.visibility.max_views; }, CLI::NonNegativeNumber));
-  t.push_back(value("--preferred-view-angle", "preferred_view_angle_degrees",
+                    [](auto& o) -> auto& { return o.visibility.max_views; }));
+  t.push_back(value("--preferred-view-angle", "preferred_view_angle_degrees", "visibility.preferred_angle_degrees",
                     "Views beyond this angle to the normal (up to --max-view-angle) only top a vertex's views up to "
                     "--min-views, the closest first (degrees)",
-                    [](auto& o) -> auto& { return o.visibility.preferred_angle_degrees; }, CLI::Range(0.001, 90.0)));
-  t.push_back(value("--min-views", "min_views", "See --preferred-view-angle",
-                    [](auto& o) -> auto& { return o.visibility.min_views; }, CLI::Range(2, 1000)));
-  t.push_back(value("--image-levels", "image_levels",
+                    [](auto& o) -> auto& { return o.visibility.preferred_angle_degrees; }));
+  t.push_back(value("--min-views", "min_views", "visibility.min_views", "See --preferred-view-angle",
+                    [](auto& o) -> auto& { return o.visibility.min_views; }));
+  t.push_back(value("--image-levels", "image_levels", "image_levels",
                     "Start on the photographs halved this many times, one level finer each time the flow settles",
-                    [](auto& o) -> auto& { return o.image_levels; }, CLI::Range(0, 4)));
+                    [](auto& o) -> auto& { return o.image_levels; }));
   t.push_back(on_off("--normalize", "photo_normalize",
                      "Per-view gain/bias normalisation of the patches before the variance (on/off)",
                      [](auto& o) -> auto& { return o.photo.photo.normalize; }));
-  t.push_back(value("--noise-floor", "photo_noise_floor",
+  t.push_back(value("--noise-floor", "photo_noise_floor", "photo.photo.noise_floor",
                     "Normalisation: contrast floor σ₀ on [0,1] values (flat patches are not stretched beyond it)",
-                    [](auto& o) -> auto& { return o.photo.photo.noise_floor; }, CLI::Range(0.0, 1.0)));
-  t.push_back(value("--drop-views", "drop_views",
+                    [](auto& o) -> auto& { return o.photo.photo.noise_floor; }));
+  t.push_back(value("--drop-views", "drop_views", "photo.photo.drop_views",
                     "Drop up to this many outlier views per vertex (the patches farthest from the mean)",
-                    [](auto& o) -> auto& { return o.photo.photo.drop_views; }, CLI::Range(0, 64)));
-  t.push_back(value("--drop-min-views", "drop_min_views", "... while more than this many views remain",
-                    [](auto& o) -> auto& { return o.photo.photo.min_views; }, CLI::Range(2, 1000)));
+                    [](auto& o) -> auto& { return o.photo.photo.drop_views; }));
+  t.push_back(value("--drop-min-views", "drop_min_views", "photo.photo.min_views", "... while more than this many views remain",
+                    [](auto& o) -> auto& { return o.photo.photo.min_views; }));
   t.push_back(on_off("--spread-unobserved", "spread_unobserved",
                      "Vertices without g or ∇g take the observed surface's displacement (harmonic, from the surface "
                      "the flow started on) when the flow converges at a resolution and at the end (on/off)",
                      [](auto& o) -> auto& { return o.unobserved_displacement.enabled; }));
-  t.push_back(value("--observed-view-angle", "observed_view_angle_degrees",
+  t.push_back(value("--observed-view-angle", "observed_view_angle_degrees", "unobserved_displacement.observed_angle_degrees",
                     "--spread-unobserved on: a vertex counts as observed when it has a speed and a view within this "
                     "angle of its normal (degrees)",
-                    [](auto& o) -> auto& { return o.unobserved_displacement.observed_angle_degrees; },
-                    CLI::Range(0.001, 90.0)));
-  t.push_back(value("--observed-erode", "observed_erode_rings",
+                    [](auto& o) -> auto& { return o.unobserved_displacement.observed_angle_degrees; }));
+  t.push_back(value("--observed-erode", "observed_erode_rings", "unobserved_displacement.erode_rings",
                     "--spread-unobserved on: shrink the observed set by this many rings before following it",
-                    [](auto& o) -> auto& { return o.unobserved_displacement.erode_rings; }, CLI::Range(0, 100)));
+                    [](auto& o) -> auto& { return o.unobserved_displacement.erode_rings; }));
   t.push_back(on_off("--fill-unobserved", "fill_unobserved",
                      "Vertices without g or ∇g move with their observed neighbours (on/off)",
                      [](auto& o) -> auto& { return o.unobserved.fill; }));
-  t.push_back(value("--weak-view-angle", "weak_view_angle_degrees",
+  t.push_back(value("--weak-view-angle", "weak_view_angle_degrees", "unobserved.weak_angle_degrees",
                     "--fill-unobserved on: a vertex whose views all lie beyond this angle to its normal follows its "
                     "neighbours too (degrees; 90 = only vertices without g or ∇g)",
-                    [](auto& o) -> auto& { return o.unobserved.weak_angle_degrees; }, CLI::Range(0.001, 90.0)));
-  t.push_back(value("--smoothing", "smoothing_lambda_dt", "Curvature-normal smoothing λ·dt per step",
+                    [](auto& o) -> auto& { return o.unobserved.weak_angle_degrees; }));
+  t.push_back(value("--smoothing", "smoothing_lambda_dt", "smoothing.lambda_dt", "Curvature-normal smoothing λ·dt per step",
                     [](auto& o) -> auto& { return o.smoothing.lambda_dt; }));
-  t.push_back(value("--smoothing-steps", "smoothing_steps", "Smoothing steps per iteration",
+  t.push_back(value("--smoothing-steps", "smoothing_steps", "smoothing.steps", "Smoothing steps per iteration",
                     [](auto& o) -> auto& { return o.smoothing.steps; }));
-  t.push_back(value("--taubin-pass-band", "smoothing_taubin_pass_band",
+  t.push_back(value("--taubin-pass-band", "smoothing_taubin_pass_band", "smoothing.taubin_pass_band",
                     "Taubin k_PB: each smoothing step is followed by one with −μ = −λ/(1 − k_PB·λ), so smoothing does "
                     "not shrink the surface (0 = off, the thesis)",
-                    [](auto& o) -> auto& { return o.smoothing.taubin_pass_band; }, CLI::NonNegativeNumber));
-  t.push_back(value("--regularization", "regularization_strength", "Tangential regularization C per step",
+                    [](auto& o) -> auto& { return o.smoothing.taubin_pass_band; }));
+  t.push_back(value("--regularization", "regularization_strength", "regularization.strength", "Tangential regularization C per step",
                     [](auto& o) -> auto& { return o.regularization.strength; }));
-  t.push_back(value("--regularization-steps", "regularization_steps", "Regularization steps per iteration",
+  t.push_back(value("--regularization-steps", "regularization_steps", "regularization.steps", "Regularization steps per iteration",
                     [](auto& o) -> auto& { return o.regularization.steps; }));
-  t.push_back(value("--epsilon", "epsilon_percent", "Stop when Σg changes less than this (percent) over 5 iterations",
+  t.push_back(value("--epsilon", "epsilon_percent", "stopping.epsilon_percent", "Stop when Σg changes less than this (percent) over 5 iterations",
                     [](auto& o) -> auto& { return o.stopping.epsilon_percent; }));
-  t.push_back(value("--min-iterations", "min_iterations", "No stop before this iteration",
+  t.push_back(value("--min-iterations", "min_iterations", "stopping.min_iterations", "No stop before this iteration",
                     [](auto& o) -> auto& { return o.stopping.min_iterations; }));
-  t.push_back(value("--max-iterations", "max_iterations", "Stop after this many iterations (over all resolutions)",
+  t.push_back(value("--max-iterations", "max_iterations", "stopping.max_iterations", "Stop after this many iterations (over all resolutions)",
                     [](auto& o) -> auto& { return o.stopping.max_iterations; }));
-  t.push_back(value("--step-tolerance", "median_move_tolerance", "Stop when the median move is below this × e_min",
+  t.push_back(value("--step-tolerance", "median_move_tolerance", "stopping.median_move_tolerance", "Stop when the median move is below this × e_min",
                     [](auto& o) -> auto& { return o.stopping.median_move_tolerance; }));
   t.push_back(switch_flag("--no-remeshing", "global_remeshing", "Skip the global split/collapse before the flow",
                           [](auto& o) -> auto& { return o.global_remeshing; }, false));
-  t.push_back(value("--refine-min-pixels", "adaptive_min_edge_pixels",
+  t.push_back(value("--refine-min-pixels", "adaptive_min_edge_pixels", "adaptive.min_edge_pixels",
                     "Adaptive refinement leaves faces with an edge shorter than this many pixels at the object",
                     [](auto& o) -> auto& { return o.adaptive.min_edge_pixels; }));
-  t.push_back(value("--refine-curvature", "adaptive_curvature_factor",
+  t.push_back(value("--refine-curvature", "adaptive_curvature_factor", "adaptive.curvature_factor",
                     "Adaptive refinement marks vertices whose curvature-normal length exceeds this × e_S",
                     [](auto& o) -> auto& { return o.adaptive.curvature_factor; }));
-  t.push_back(value("--untangle-rounds", "untangle_rounds",
+  t.push_back(value("--untangle-rounds", "untangle_rounds", "untangling.max_rounds",
                     "Rounds of fold removal (smoothing around crossing faces) before each refinement and at the end; "
                     "0 disables (thesis preset)",
                     [](auto& o) -> auto& { return o.untangling.max_rounds; }));
-  t.push_back(value("--refine-min-growth", "adaptive_min_growth",
+  t.push_back(value("--refine-min-growth", "adaptive_min_growth", "adaptive.min_growth",
                     "A refinement that would add fewer than this fraction of the vertices is not done (coarse to "
                     "fine, the run then ends; thesis preset: 0)",
                     [](auto& o) -> auto& { return o.adaptive.min_growth; }));
@@ -224,24 +255,24 @@ std::vector<RefineOptionEntry> make_table() {
                      "i.e. a background the threshold separates; thesis preset: off)",
                      {{"off", RimFit::Off}, {"on", RimFit::On}, {"auto", RimFit::Auto}},
                      [](auto& o) -> auto& { return o.rims.fit; }));
-  t.push_back(value("--rim-angle", "rim_angle_degrees",
+  t.push_back(value("--rim-angle", "rim_angle_degrees", "rims.rim_angle_degrees",
                     "--fit-silhouettes on: a vertex is a rim of a view within this angle of 90° between its normal "
                     "and the view's ray (degrees)",
-                    [](auto& o) -> auto& { return o.rims.rim_angle_degrees; }, CLI::Range(0.001, 89.999)));
-  t.push_back(value("--rim-dead-zone", "rim_dead_zone_pixels",
+                    [](auto& o) -> auto& { return o.rims.rim_angle_degrees; }));
+  t.push_back(value("--rim-dead-zone", "rim_dead_zone_pixels", "rims.dead_zone_pixels",
                     "--fit-silhouettes on: boundaries nearer than this many pixels are left to the photo consistency",
-                    [](auto& o) -> auto& { return o.rims.dead_zone_pixels; }, CLI::Range(0.0, 63.0)));
-  t.push_back(value("--rim-step", "rim_step",
+                    [](auto& o) -> auto& { return o.rims.dead_zone_pixels; }));
+  t.push_back(value("--rim-step", "rim_step", "rims.step",
                     "--fit-silhouettes on: the fraction of the distance to the boundary moved per iteration",
-                    [](auto& o) -> auto& { return o.rims.step; }, CLI::Range(0.001, 1.0)));
-  t.push_back(value("--silhouette-threshold", "silhouette_threshold",
+                    [](auto& o) -> auto& { return o.rims.step; }));
+  t.push_back(value("--silhouette-threshold", "silhouette_threshold", "silhouettes.threshold",
                     "Silhouettes for --keep-inside-silhouettes and --fit-silhouettes: largest channel above this (on [0,1])",
                     [](auto& o) -> auto& { return o.silhouettes.threshold; }));
-  t.push_back(value("--silhouette-dilate", "silhouette_dilate", "... dilated by this many pixels",
+  t.push_back(value("--silhouette-dilate", "silhouette_dilate", "silhouettes.dilate", "... dilated by this many pixels",
                     [](auto& o) -> auto& { return o.silhouettes.dilate; }));
   t.push_back(switch_flag("--no-adaptive", "adaptive_refinement", "Skip adaptive refinement between iterations",
                           [](auto& o) -> auto& { return o.adaptive_refinement; }, false));
-  t.push_back({"--exclude-views", "excluded_views",
+  t.push_back({"--exclude-views", "excluded_views", {"excluded_views"},
                [](CLI::App& command) {
                  return command.add_option("--exclude-views", "0-based views not to use (held out)")
                      ->type_name("INT")
@@ -269,6 +300,15 @@ RefineOptions resolve_refine_options(const std::string& preset_name, const CLI::
   for (const RefineOptionEntry& entry : refine_option_table()) {
     const CLI::Option* given = command.get_option_no_throw(entry.flag);
     if (given && given->count() > 0) entry.apply(*given, options);
+  }
+  // Validated as a whole, after every flag: a range may depend on another option (Taubin's μ on λ).
+  try {
+    options.check();
+  } catch (const OptionError& e) {
+    for (const RefineOptionEntry& entry : refine_option_table())
+      if (std::find(entry.members.begin(), entry.members.end(), e.option()) != entry.members.end())
+        throw CLI::ValidationError(entry.flag, e.what());
+    throw CLI::ValidationError(e.what());
   }
   return options;
 }

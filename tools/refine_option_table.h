@@ -1,8 +1,10 @@
 #pragma once
 // Every option of `mvflow refine` that sets a RefineOptions field, declared once: its flag, its
-// key in the report's "options", the field it sets, its valid values and its help. Registration on
-// the command line, applying what the user gave over the preset, and the report all walk this one
-// table, so a flag cannot be registered under one name and read under another.
+// key in the report's "options", the field it sets (and the field's name in RefineOptions::check's
+// errors) and its help. Registration on the command line, --help, applying what the user gave over
+// the preset, validation and the report all walk this one table, so a flag cannot be registered
+// under one name and read under another. The valid values are not written here: they are the
+// stages' own check()s, which --help and a refused flag quote.
 
 #include <CLI/CLI.hpp>
 #include <functional>
@@ -17,7 +19,10 @@ namespace mvflow::cli {
 struct RefineOptionEntry {
   std::string flag;  //!< e.g. "--cfl"
   std::string key;   //!< e.g. "cfl" in the report's "options"
-  //! Registers the flag on \p command with its help, its check and, for --help, the default
+  //! The fields it sets as RefineOptions::check names them ("smoothing.lambda_dt"), so that a value
+  //! out of range is reported under the flag; empty for choices (CLI11 checks those).
+  std::vector<std::string> members;
+  //! Registers the flag on \p command with its help, for --help its valid values and the default
   //! preset's value.
   std::function<CLI::Option*(CLI::App& command)> add;
   //! Sets the field of \p target from what the user gave (called only when the flag was given).
@@ -32,8 +37,9 @@ const std::vector<RefineOptionEntry>& refine_option_table();
 //! Registers every entry's flag on \p command.
 void add_refine_options(CLI::App& command);
 
-//! The preset \p preset_name with every option the user gave on \p command applied (ranges are
-//! checked by the flags' validators and by RefineOptions::check when the refinement starts).
+//! The preset \p preset_name with every option the user gave on \p command applied, checked by
+//! RefineOptions::check. \throw CLI::ValidationError naming the flag of the first value out of
+//! range, the field, the value and the valid values.
 RefineOptions resolve_refine_options(const std::string& preset_name, const CLI::App& command);
 
 //! {"preset": NAME, KEY: value...} for every entry.

@@ -11,9 +11,9 @@ IterationGraph::Node* IterationGraph::add(std::function<void()> body) {
   return nodes_.back().get();
 }
 
-IterationGraph::IterationGraph(IterationData& data) : n_blocks_(data.blocks.size()) {
+IterationGraph::IterationGraph(IterationData& data) {
   const IterationPhases schedule = iteration_phases(data.options, data.rim_masks != nullptr);
-  const std::size_t n = n_blocks_;
+  const std::size_t n = data.blocks.size();
   start_ = add([&data] { data.refit(); });
 
   // Per block, the pipeline's kernels in a chain, each block independent of the others.

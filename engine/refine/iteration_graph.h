@@ -37,7 +37,6 @@ class IterationGraph {
   //! whole graph with empty bodies takes 0.06 ms at 10k vertices, perf/README.md), so the flag
   //! needs no cancellation of the graph's task_group_context.
   void run();
-  std::size_t n_blocks() const { return n_blocks_; }
 
  private:
   using Node = oneapi::tbb::flow::continue_node<oneapi::tbb::flow::continue_msg>;
@@ -46,7 +45,6 @@ class IterationGraph {
   oneapi::tbb::flow::graph graph_;  // declared before the nodes: it must outlive them
   std::vector<std::unique_ptr<Node>> nodes_;
   Node* start_ = nullptr;
-  std::size_t n_blocks_ = 0;
 };
 
 }  // namespace mvflow

@@ -1,34 +1,34 @@
 #include "engine/refine/refine_options.h"
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 
 void RefineOptions::check() const {
-  auto require = [](bool ok, const char* what) {
-    if (!ok) throw InputError(std::string("option out of range: ") + what);
-  };
-  require(visibility.check(), "visibility (max angle in (0, 90], patch, ray offset, max views 0 or >= 2)");
-  require(photo.check(), "photo consistency / Savitzky-Golay (k even >= 2, order, patch 1..7, noise floor in [0, 1], "
-                         "drop views 0..64, min views >= 2)");
-  require(unobserved.check(), "unobserved speed (rings >= 1)");
-  require(unobserved_displacement.check(), "observed view angle in (0, 90]");
-  require(speed.check(), "velocity");
-  require(cfl > 0 && cfl <= 10, "cfl (0, 10]");
-  require(speed_quantile > 0 && speed_quantile <= 1, "speed quantile (0, 1]");
-  require(smoothing.check(), "smoothing (lambda*dt in (0,1), steps >= 0, Taubin pass band >= 0 with mu < 1)");
-  require(regularization.check(), "regularization (strength in (0,1], steps >= 0)");
-  require(stopping.check(), "stopping (epsilon, iterations, lookback, tolerance)");
-  require(remeshing.check(), "remeshing factors");
-  require(adaptive.check(), "adaptive refinement thresholds (min growth in [0, 1))");
-  require(untangling.check(), "untangling (rounds >= 0, ring >= 0, steps >= 1, fraction in (0, 1])");
-  require(block_size >= 1, "block size >= 1");
-  require(image_levels >= 0 && image_levels <= 4, "image levels 0..4");
-  require(silhouettes.check(), "silhouettes (threshold in [0, 1), dilation >= 0)");
-  require(rims.check(), "silhouette rims (angle in (0, 90), dead zone >= 0 below the search distance <= 64 pixels, "
-                        "step in (0, 1], ray offset >= 0, holes in [0, 1])");
-  require(photo.photo.half_patch == visibility.half_patch, "the visibility patch must equal the photo patch");
-  for (int view : excluded_views) require(view >= 0, "excluded views are 0-based indices");
+  // Each stage checks its own options, where their ranges are written; a failing field is named by
+  // its path (smoothing.lambda_dt), which the command line maps back to its flag. The photo
+  // options come before the visibility's: the patch's range is theirs.
+  check_member(photo, "photo");
+  check_member(visibility, "visibility");
+  check_member(unobserved, "unobserved");
+  check_member(unobserved_displacement, "unobserved_displacement");
+  check_member(speed, "speed");
+  require_option(cfl > 0 && cfl <= 10, "cfl", cfl, "(0, 10]");
+  require_option(speed_quantile > 0 && speed_quantile <= 1, "speed_quantile", speed_quantile, "(0, 1]");
+  check_member(smoothing, "smoothing");
+  check_member(regularization, "regularization");
+  check_member(stopping, "stopping");
+  check_member(remeshing, "remeshing");
+  check_member(adaptive, "adaptive");
+  check_member(untangling, "untangling");
+  require_option(block_size >= 1, "block_size", block_size, ">= 1");
+  require_option(image_levels >= 0 && image_levels <= 4, "image_levels", image_levels, "[0, 4]");
+  check_member(silhouettes, "silhouettes");
+  check_member(rims, "rims");
+  require_option(visibility.half_patch == photo.photo.half_patch, "visibility.half_patch", visibility.half_patch,
+                 "photo.photo.half_patch (" + std::to_string(photo.photo.half_patch) + ")");
+  for (int view : excluded_views) require_option(view >= 0, "excluded_views", view, ">= 0 (0-based view indices)");
 }
 
 RefineOptions default_preset() { return RefineOptions{}; }

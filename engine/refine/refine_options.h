@@ -100,7 +100,9 @@ struct RefineOptions {
   //! (README, "Defaults and differences"); off in the thesis preset.
   SilhouetteRimOptions rims;
 
-  //! \throw InputError naming the first option out of range.
+  //! Runs every stage's check() and checks the fields of its own.
+  //! \throw OptionError naming the first field out of range by its path ("smoothing.lambda_dt"),
+  //! its value and its valid values.
   void check() const;
 };
 

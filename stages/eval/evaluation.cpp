@@ -11,6 +11,7 @@
 
 #include "engine/model/bounding_box.h"
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "engine/model/surface_query.h"
 
 namespace mvflow {
@@ -59,8 +60,10 @@ BoundingBox bounding_box_of(const IndexedMesh& mesh) {
 
 }  // namespace
 
-bool EvaluationOptions::check() const {
-  return samples > 0 && accuracy_fraction > 0 && accuracy_fraction <= 1 && completeness_threshold >= 0;
+void EvaluationOptions::check() const {
+  require_option(samples > 0, "samples", samples, "> 0");
+  require_option(accuracy_fraction > 0 && accuracy_fraction <= 1, "accuracy_fraction", accuracy_fraction, "(0, 1]");
+  require_option(completeness_threshold >= 0, "completeness_threshold", completeness_threshold, ">= 0");
 }
 
 double EvaluationResult::symmetric_rms() const {
@@ -101,7 +104,7 @@ std::vector<Eigen::Vector3d> sample_surface(const IndexedMesh& mesh, std::size_t
 
 EvaluationResult evaluate_against_truth(const IndexedMesh& mesh, const IndexedMesh& truth,
                                         const EvaluationOptions& options) {
-  if (!options.check()) throw InputError("evaluation options out of range");
+  options.check();
   if (mesh.triangles.empty()) throw InputError("the mesh to evaluate has no triangles");
   if (truth.triangles.empty()) throw InputError("the ground-truth mesh has no triangles");
   EvaluationResult result;

@@ -16,7 +16,8 @@ struct EvaluationOptions {
   double accuracy_fraction = 0.9;         //!< accuracy is this quantile of mesh→truth distances
   double completeness_threshold = 0.01;   //!< relative to the truth's bounding-box diagonal
   std::uint64_t seed = 1;                 //!< sampling is deterministic for a given seed
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! Distances from one surface's samples to another surface.

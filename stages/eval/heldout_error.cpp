@@ -10,12 +10,16 @@
 
 #include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
+#include "engine/model/option_check.h"
+#include "engine/model/supersample.h"
 
 namespace mvflow {
 
-bool HeldoutOptions::check() const {
-  return supersample >= 1 && supersample <= 8 && background.allFinite() && background.minCoeff() >= 0.0f &&
-         background.maxCoeff() <= 1.0f && colouring.check();
+void HeldoutOptions::check() const {
+  require_option(supersample >= 1 && supersample <= 8, "supersample", supersample, "[1, 8]");
+  require_option(background.allFinite() && background.minCoeff() >= 0.0f && background.maxCoeff() <= 1.0f,
+                 "background", background.transpose(), "R G B in [0, 1]");
+  check_member(colouring, "colouring");
 }
 
 double HeldoutMetrics::mae() const {
@@ -90,7 +94,7 @@ InputError scene_error(const Scene& scene, const std::string& message) {
 // The held-out list, checked against the scene before anything expensive happens.
 std::vector<int> checked_held_out(const Scene& scene, std::vector<int> held_out,
                                   const HeldoutOptions& options) {
-  if (!options.check()) throw InputError("held-out options out of range");
+  options.check();
   if (held_out.empty()) throw InputError("no held-out view given");
   const int count = static_cast<int>(scene.size());
   for (int view : held_out)
@@ -170,15 +174,12 @@ HeldoutRendering HeldoutRenderer::render(int view) const {
     for (int x = 0; x < w; ++x) {
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       int valued = 0, hits = 0, unseen = 0;
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-          // Sub-pixel centres around the pixel centre (mvflow's pixel (0,0) is a centre).
-          const Ray ray = camera.ray(x + (i + 0.5) / n - 0.5, y + (j + 0.5) / n - 0.5);
+      for_each_subpixel_ray(camera, x, y, n, [&](const Ray& ray) {
           const auto hit = surface_.intersect(ray.origin, ray.direction);
           if (!hit) {
             sum += options_.background;
             ++valued;
-            continue;
+            return;
           }
           ++hits;
           const auto& t = flat_.triangles[hit->face];
@@ -193,11 +194,11 @@ HeldoutRendering HeldoutRenderer::render(int view) const {
               colour_surface_point(point, normal, colouring_views_, surface_, mean_edge_, options_.colouring);
           if (c.views == 0) {
             ++unseen;
-            continue;
+            return;
           }
           sum += c.colour;
           ++valued;
-        }
+        });
       const std::size_t index = static_cast<std::size_t>(y) * w + x;
       r.silhouette.inside[index] = 2 * hits >= rays;
       r.unseen[index] = 2 * unseen >= rays;

@@ -34,7 +34,8 @@ struct HeldoutOptions {
   Eigen::Vector3f background{0.0f, 0.0f, 0.0f};
   //! Which views colour a surface point (grazing angle, occlusion-ray offset).
   PointColouringOptions colouring;
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! One held-out view rendered from the mesh. Pixel (x, y) is index y·width + x.

@@ -6,12 +6,18 @@
 #include <cmath>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
+#include "engine/model/supersample.h"
 #include "engine/model/surface_query.h"
 
 namespace mvflow {
 
+void MeshRenderOptions::check() const {
+  require_option(supersample >= 1 && supersample <= 8, "supersample", supersample, "[1, 8]");
+}
+
 MeshRendering render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOptions& options) {
-  if (!options.check()) throw InputError("render options out of range");
+  options.check();
   if (options.shading == MeshShading::Coloured && mesh.colors.size() != mesh.n_vertices())
     throw InputError("coloured rendering needs per-vertex colours (a PLY written by mvflow refine has them)");
   const IndexedMesh flat = to_indexed(mesh);
@@ -23,14 +29,11 @@ MeshRendering render_mesh(const Mesh& mesh, const Camera& camera, const MeshRend
     for (int u = 0; u < camera.width(); ++u) {
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       int hits = 0;
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-          // Sub-pixel centres around the pixel centre (mvflow's pixel (0,0) is a centre).
-          const Ray ray = camera.ray(u + (i + 0.5) / n - 0.5, v + (j + 0.5) / n - 0.5);
+      for_each_subpixel_ray(camera, u, v, n, [&](const Ray& ray) {
           const auto hit = surface.intersect(ray.origin, ray.direction);
           if (!hit) {
             sum += options.background;
-            continue;
+            return;
           }
           ++hits;
           const auto& t = flat.triangles[hit->face];
@@ -44,7 +47,7 @@ MeshRendering render_mesh(const Mesh& mesh, const Camera& camera, const MeshRend
             const float light = static_cast<float>(std::abs(normal.dot(ray.direction)));
             sum += Eigen::Vector3f::Constant(0.15f + 0.85f * light);
           }
-        }
+        });
       result.image.set_pixel(u, v, sum / static_cast<float>(n * n));
       result.coverage[static_cast<std::size_t>(v) * camera.width() + u] = static_cast<float>(hits) / (n * n);
     }

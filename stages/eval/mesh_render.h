@@ -21,7 +21,8 @@ struct MeshRenderOptions {
   MeshShading shading = MeshShading::Shaded;
   int supersample = 2;                               //!< N×N rays per pixel (anti-aliasing)
   Eigen::Vector3f background{0.0f, 0.0f, 0.0f};
-  bool check() const { return supersample >= 1 && supersample <= 8; }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 struct MeshRendering {

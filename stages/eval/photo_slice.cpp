@@ -7,14 +7,19 @@
 
 #include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
+#include "engine/model/option_check.h"
 #include "engine/model/surface_query.h"
 #include "stages/flow/normals.h"
 
 namespace mvflow {
 
-bool PhotoSliceOptions::check() const {
-  return axis >= 0 && axis <= 2 && position >= 0 && position <= 1 && resolution >= 2 && resolution <= 20000 &&
-         margin >= 0 && visibility.check() && photo.check();
+void PhotoSliceOptions::check() const {
+  require_option(axis >= 0 && axis <= 2, "axis", axis, "0, 1 or 2");
+  require_option(position >= 0 && position <= 1, "position", position, "[0, 1]");
+  require_option(resolution >= 2 && resolution <= 20000, "resolution", resolution, "[2, 20000]");
+  require_option(margin >= 0, "margin", margin, ">= 0");
+  check_member(visibility, "visibility");
+  check_member(photo, "photo");
 }
 
 std::vector<std::array<Eigen::Vector3d, 2>> plane_cross_section(const TriMesh& mesh, int axis, double value) {
@@ -39,7 +44,7 @@ std::vector<std::array<Eigen::Vector3d, 2>> plane_cross_section(const TriMesh& m
 
 PhotoSlice compute_photo_slice(const TriMesh& mesh, const std::vector<PhotoView>& views,
                                const PhotoSliceOptions& options) {
-  if (!options.check()) throw InputError("slice options out of range");
+  options.check();
   if (mesh.n_faces() == 0) throw InputError("slice: the mesh has no faces");
   BoundingBox box = bounding_box_of(mesh);
   const Eigen::Vector3d grow = options.margin * box.size();

@@ -28,7 +28,8 @@ struct PhotoSliceOptions {
   SliceViews views = SliceViews::NearestVertex;
   VisibilityOptions visibility;    //!< for SliceViews::NearestVertex
   PhotoConsistencyOptions photo;
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! The sampled plane. Sample (i, j) is at origin + i·step·u_axis + j·step·v_axis, i < width,

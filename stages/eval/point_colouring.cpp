@@ -4,13 +4,19 @@
 #include <numbers>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
+
+void PointColouringOptions::check() const {
+  require_option(max_angle_degrees > 0 && max_angle_degrees <= 90, "max_angle_degrees", max_angle_degrees, "(0, 90]");
+  require_option(ray_offset >= 0, "ray_offset", ray_offset, ">= 0");
+}
 
 PointColour colour_surface_point(const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
                                  const std::vector<PhotoView>& views, const SurfaceQuery& surface,
                                  double mean_edge, const PointColouringOptions& options) {
-  MVFLOW_CHECK(options.check(), "point colouring options out of range");
+  options.check();
   const double cos_max = std::cos(options.max_angle_degrees * std::numbers::pi / 180.0);
   const Eigen::Vector3d origin = point + options.ray_offset * mean_edge * normal;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();

@@ -23,7 +23,8 @@ struct PointColouringOptions {
   //! The occlusion ray starts this far along the normal, × the mesh's mean edge length (≥ 0), so
   //! it does not hit the point's own face (Embree traces in float). The flow's value.
   double ray_offset = 1e-3;
-  bool check() const { return max_angle_degrees > 0 && max_angle_degrees <= 90 && ray_offset >= 0; }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 struct PointColour {

@@ -5,10 +5,18 @@
 #include <cmath>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/photo_kernel.h"
 #include "stages/flow/photo_robust.h"
 
 namespace mvflow {
+
+void PhotoConsistencyOptions::check() const {
+  require_option(half_patch >= 1 && half_patch <= 7, "half_patch", half_patch, "[1, 7]");
+  require_option(noise_floor >= 0 && noise_floor <= 1, "noise_floor", noise_floor, "[0, 1]");
+  require_option(drop_views >= 0 && drop_views <= 64, "drop_views", drop_views, "[0, 64]");
+  require_option(min_views >= 2 && min_views <= 1000, "min_views", min_views, "[2, 1000]");
+}
 
 namespace detail {
 
@@ -91,7 +99,7 @@ PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint
 
 void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
                                const PhotoConsistencyOptions& options, VertexFields& fields) {
-  MVFLOW_CHECK(options.check(), "photo consistency options out of range");
+  options.check();
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     const PhotoValue value = photo_consistency(to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))),
                                                fields.visible(v), views, options);

@@ -33,10 +33,8 @@ struct PhotoConsistencyOptions {
   //! while more than min_views remain; 0 keeps every view (the thesis).
   int drop_views = 0;
   int min_views = 4;  //!< views kept at least when dropping outliers (≥ 2)
-  bool check() const {
-    return half_patch >= 1 && half_patch <= 7 && noise_floor >= 0 && noise_floor <= 1 && drop_views >= 0 &&
-           drop_views <= 64 && min_views >= 2;
-  }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! g at one point and the number of views that contributed.

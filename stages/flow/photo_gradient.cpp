@@ -3,14 +3,20 @@
 #include <span>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/photo_kernel.h"
 #include "stages/flow/photo_robust.h"
 
 namespace mvflow {
 
+void PhotoGradientOptions::check() const {
+  check_member(savitzky_golay, "savitzky_golay");
+  check_member(photo, "photo");
+}
+
 PhotoGradientStage::PhotoGradientStage(const PhotoGradientOptions& options)
     : options_(options) {
-  MVFLOW_CHECK(options.check(), "photo gradient options out of range");
+  options.check();
   coefficients_ = savitzky_golay_derivative_coefficients(options.savitzky_golay.half_window(),
                                                          options.savitzky_golay.order);
 }

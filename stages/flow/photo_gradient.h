@@ -19,7 +19,8 @@ namespace mvflow {
 struct PhotoGradientOptions {
   SavitzkyGolayOptions savitzky_golay;  //!< k = 20, quartic (thesis B.7)
   PhotoConsistencyOptions photo;        //!< patch used for every sample
-  bool check() const { return savitzky_golay.check() && photo.check(); }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! Precomputed Savitzky–Golay coefficients; one per run, shared by every block (read-only).

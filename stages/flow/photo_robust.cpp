@@ -62,7 +62,7 @@ PhotoValue normalized_photo_consistency(const Eigen::Vector3d& X, std::span<cons
 
 void drop_outlier_views(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
                         const PhotoConsistencyOptions& options, VertexFields& fields) {
-  MVFLOW_CHECK(options.check(), "photo consistency options out of range");
+  options.check();
   if (options.drop_views == 0) return;
   const int count = patch_values(options.half_patch);
   // Buffers for the whole block: the patches of one vertex's views (normalised when asked), the

@@ -2,20 +2,22 @@
 
 #include <cmath>
 
+#include "engine/model/one_ring.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/commit.h"
 #include "stages/flow/normals.h"
-#include "engine/model/one_ring.h"
 
 namespace mvflow {
 
-bool RegularizationOptions::check() const {
-  return strength > 0.0 && strength <= 1.0 && steps >= 0;
+void RegularizationOptions::check() const {
+  require_option(strength > 0.0 && strength <= 1.0, "strength", strength, "(0, 1]");
+  require_option(steps >= 0, "steps", steps, ">= 0");
 }
 
 void regularize_tangential(const TriMesh& mesh, IndexRange vertices, const VertexFields& fields,
                            const RegularizationOptions& options,
                            std::vector<Eigen::Vector3d>& new_positions) {
-  MVFLOW_CHECK(options.check(), "regularize_tangential: invalid RegularizationOptions");
+  options.check();
   detail::check_range(vertices, mesh.n_vertices(), "regularize_tangential");
   MVFLOW_CHECK(fields.size() == mesh.n_vertices() && fields.normal.size() == mesh.n_vertices(),
                "regularize_tangential: fields are not sized for the mesh");
@@ -37,7 +39,7 @@ void regularize_tangential(const TriMesh& mesh, IndexRange vertices, const Verte
 }
 
 void apply_regularization(TriMesh& mesh, const RegularizationOptions& options) {
-  MVFLOW_CHECK(options.check(), "apply_regularization: invalid RegularizationOptions");
+  options.check();
   const IndexRange all{0, static_cast<std::uint32_t>(mesh.n_vertices())};
   VertexFields fields;
   fields.resize(mesh.n_vertices(), 0);

@@ -18,7 +18,8 @@ struct RegularizationOptions {
   //! Regularization steps per call of apply_regularization (per flow iteration); ≥ 0.
   int steps = 1;
 
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! One Jacobi step of tangential Laplace regularization (thesis eq. 3.9 with the umbrella

@@ -3,11 +3,13 @@
 #include <Eigen/Dense>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 
-bool SavitzkyGolayOptions::check() const {
-  return k >= 2 && k % 2 == 0 && order >= 1 && order <= k;
+void SavitzkyGolayOptions::check() const {
+  require_option(k >= 2 && k % 2 == 0, "k", k, "an even number >= 2");
+  require_option(order >= 1 && order <= k, "order", order, "[1, k]");
 }
 
 std::vector<double> savitzky_golay_derivative_coefficients(int half_window, int order) {

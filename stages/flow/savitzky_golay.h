@@ -24,7 +24,8 @@ struct SavitzkyGolayOptions {
   int half_window() const { return k / 2; }
   //! Δx = e_min / (2k): the sample spacing for a mesh whose shortest edge is \p shortest_edge.
   double sample_spacing(double shortest_edge) const { return shortest_edge / (2.0 * k); }
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! Coefficients c_s, s = −half_window..half_window (element s + half_window), of the first

@@ -5,8 +5,14 @@
 #include <numeric>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
+
+void SilhouetteOptions::check() const {
+  require_option(threshold >= 0.0 && threshold < 1.0, "threshold", threshold, "[0, 1)");
+  require_option(dilate >= 0 && dilate <= 1000, "dilate", dilate, "[0, 1000]");
+}
 
 namespace {
 
@@ -19,7 +25,7 @@ std::size_t Mask::count() const {
 }
 
 Mask threshold_silhouette(const Image& image, const SilhouetteOptions& options) {
-  MVFLOW_CHECK(options.check(), "silhouette options out of range");
+  options.check();
   Mask mask(image.width(), image.height());
   const float* data = image.data();
   const float threshold = static_cast<float>(options.threshold);

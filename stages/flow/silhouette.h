@@ -30,7 +30,8 @@ struct SilhouetteOptions {
   double threshold = 0.19;
   //! Dilation radius in pixels (a disc), ≥ 0; 0 keeps the thresholded mask.
   int dilate = 0;
-  bool check() const { return threshold >= 0.0 && threshold < 1.0 && dilate >= 0 && dilate <= 1000; }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! The object's silhouette in \p image by thresholding its largest channel, then dilated.

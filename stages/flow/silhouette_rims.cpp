@@ -5,10 +5,23 @@
 #include <numbers>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/flow/silhouette_constraint.h"
 #include "stages/flow/silhouette_holes.h"
 
 namespace mvflow {
+
+void SilhouetteRimOptions::check() const {
+  require_option(rim_angle_degrees > 0 && rim_angle_degrees < 90, "rim_angle_degrees", rim_angle_degrees, "(0, 90)");
+  require_option(dead_zone_pixels >= 0 && dead_zone_pixels < search_pixels, "dead_zone_pixels", dead_zone_pixels,
+                 "[0, search_pixels)");
+  require_option(search_pixels <= 64, "search_pixels", search_pixels, "(dead_zone_pixels, 64]");
+  require_option(step > 0 && step <= 1, "step", step, "(0, 1]");
+  require_option(ray_offset >= 0, "ray_offset", ray_offset, ">= 0");
+  require_option(fill_holes >= 0 && fill_holes <= 1, "fill_holes", fill_holes, "[0, 1]");
+  require_option(dark_border_fraction > 0 && dark_border_fraction <= 1, "dark_border_fraction", dark_border_fraction,
+                 "(0, 1]");
+}
 
 namespace {
 

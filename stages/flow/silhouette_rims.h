@@ -51,11 +51,8 @@ struct SilhouetteRimOptions {
   //! RimFit::Auto: a view's border counts as background when at least this fraction of its
   //! pixels is at or below the silhouette threshold.
   double dark_border_fraction = 0.95;
-  bool check() const {
-    return rim_angle_degrees > 0 && rim_angle_degrees < 90 && dead_zone_pixels >= 0 &&
-           search_pixels > dead_zone_pixels && search_pixels <= 64 && step > 0 && step <= 1 && ray_offset >= 0 &&
-           fill_holes >= 0 && fill_holes <= 1 && dark_border_fraction > 0 && dark_border_fraction <= 1;
-  }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! True when, in every view, at least \p fraction of the pixels on the image's border have no

@@ -2,14 +2,19 @@
 
 #include <cmath>
 
-#include "stages/flow/commit.h"
 #include "engine/model/one_ring.h"
+#include "engine/model/option_check.h"
+#include "stages/flow/commit.h"
 
 namespace mvflow {
 
-bool SmoothingOptions::check() const {
-  return lambda_dt > 0.0 && lambda_dt < 1.0 && steps >= 0 && taubin_pass_band >= 0.0 &&
-         taubin_pass_band * lambda_dt < 1.0 && taubin_mu() < 1.0;
+void SmoothingOptions::check() const {
+  require_option(lambda_dt > 0.0 && lambda_dt < 1.0, "lambda_dt", lambda_dt, "(0, 1)");
+  require_option(steps >= 0, "steps", steps, ">= 0");
+  require_option(taubin_pass_band >= 0.0, "taubin_pass_band", taubin_pass_band, ">= 0");
+  // μ = λ/(1 − k·λ) must lie in (0, 1): a negative μ would shrink a second time.
+  require_option(taubin_pass_band * lambda_dt < 1.0 && taubin_mu() < 1.0, "taubin_pass_band", taubin_pass_band,
+                 "< 1/lambda_dt − 1 (Taubin's mu = lambda/(1 − k·lambda) below 1)");
 }
 
 namespace {
@@ -41,18 +46,19 @@ void step_toward_centroid(const TriMesh& mesh, IndexRange vertices, double facto
 
 void smooth_curvature_normal(const TriMesh& mesh, IndexRange vertices, const SmoothingOptions& options,
                              std::vector<Eigen::Vector3d>& new_positions) {
-  MVFLOW_CHECK(options.check(), "smooth_curvature_normal: invalid SmoothingOptions");
+  options.check();
   step_toward_centroid(mesh, vertices, options.lambda_dt, new_positions);
 }
 
 void inflate_curvature_normal(const TriMesh& mesh, IndexRange vertices, const SmoothingOptions& options,
                               std::vector<Eigen::Vector3d>& new_positions) {
-  MVFLOW_CHECK(options.check() && options.taubin_pass_band > 0.0, "inflate_curvature_normal: invalid SmoothingOptions");
+  options.check();
+  MVFLOW_CHECK(options.taubin_pass_band > 0.0, "inflate_curvature_normal: needs a Taubin pass band > 0");
   step_toward_centroid(mesh, vertices, -options.taubin_mu(), new_positions);
 }
 
 void apply_smoothing(TriMesh& mesh, const SmoothingOptions& options) {
-  MVFLOW_CHECK(options.check(), "apply_smoothing: invalid SmoothingOptions");
+  options.check();
   const IndexRange all{0, static_cast<std::uint32_t>(mesh.n_vertices())};
   std::vector<Eigen::Vector3d> buffer(mesh.n_vertices());
   for (int step = 0; step < options.steps; ++step) {

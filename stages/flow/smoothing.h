@@ -26,7 +26,8 @@ struct SmoothingOptions {
   //! μ of the second step (0 when taubin_pass_band is 0).
   double taubin_mu() const { return taubin_pass_band > 0.0 ? lambda_dt / (1.0 - taubin_pass_band * lambda_dt) : 0.0; }
 
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! One Jacobi step of curvature-normal smoothing (thesis eq. 3.11 with the normalized operator

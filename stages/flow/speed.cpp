@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "engine/model/one_ring.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 namespace {
@@ -13,12 +14,12 @@ constexpr std::uint8_t speed_inputs = kPhotoDefined | kGradientDefined | kNormal
 
 }  // namespace
 
-bool SpeedOptions::check() const {
-  return std::isfinite(velocity);
+void SpeedOptions::check() const {
+  require_option(std::isfinite(velocity), "velocity", velocity, "a finite number");
 }
 
 void compute_speed(IndexRange vertices, const SpeedOptions& options, VertexFields& fields) {
-  MVFLOW_CHECK(options.check(), "compute_speed: invalid SpeedOptions");
+  options.check();
   detail::check_range(vertices, fields.size(), "compute_speed");
   for (std::uint32_t id = vertices.begin; id < vertices.end; ++id) {
     fields.speed[id] = Eigen::Vector3d::Zero();

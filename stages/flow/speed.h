@@ -17,7 +17,8 @@ struct SpeedOptions {
   //! (thesis B.7).
   double velocity = 0.001;
 
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! Computes the speed of every vertex in \p vertices (thesis eq. 4.13 with an outward normal):

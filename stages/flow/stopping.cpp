@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 
@@ -22,14 +23,19 @@ const char* to_string(StopReason reason) {
   return "unknown";
 }
 
-bool StoppingOptions::check() const {
-  return epsilon_percent > 0.0 && std::isfinite(epsilon_percent) && lookback >= 1 &&
-         min_iterations >= lookback + 1 && max_iterations >= min_iterations && median_move_tolerance >= 0.0 &&
-         std::isfinite(median_move_tolerance);
+void StoppingOptions::check() const {
+  require_option(epsilon_percent > 0.0 && std::isfinite(epsilon_percent), "epsilon_percent", epsilon_percent,
+                 "> 0 and finite");
+  require_option(lookback >= 1, "lookback", lookback, ">= 1");
+  require_option(min_iterations >= lookback + 1, "min_iterations", min_iterations, ">= lookback + 1 (" + std::to_string(lookback + 1) + ")");
+  require_option(max_iterations >= min_iterations, "max_iterations", max_iterations,
+                 ">= min_iterations (" + std::to_string(min_iterations) + ")");
+  require_option(median_move_tolerance >= 0.0 && std::isfinite(median_move_tolerance), "median_move_tolerance",
+                 median_move_tolerance, ">= 0 and finite");
 }
 
 StoppingCriterion::StoppingCriterion(StoppingOptions options) : options_(options) {
-  MVFLOW_CHECK(options_.check(), "StoppingCriterion: invalid StoppingOptions");
+  options_.check();
   history_.reserve(static_cast<std::size_t>(options_.max_iterations));
 }
 

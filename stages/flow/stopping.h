@@ -51,7 +51,8 @@ struct StoppingOptions {
   //! three synthetic scenes; after a stop at 0.001, 2 %; README, "Defaults and differences").
   double median_move_tolerance = 0.001;
 
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! The stopping test of the flow, fed once per completed iteration.
@@ -69,7 +70,7 @@ struct StoppingOptions {
 //! keep evaluating the same rules on the longer history.
 class StoppingCriterion {
  public:
-  //! \throw Error if !options.check().
+  //! \throw OptionError if options.check() does.
   explicit StoppingCriterion(StoppingOptions options);
 
   //! Records iteration i = iterations() + 1 and returns whether to stop after it.

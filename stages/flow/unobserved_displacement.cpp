@@ -11,9 +11,16 @@
 
 #include "engine/model/camera.h"
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "engine/model/surface_query.h"
 
 namespace mvflow {
+
+void UnobservedDisplacementOptions::check() const {
+  require_option(observed_angle_degrees > 0 && observed_angle_degrees <= 90, "observed_angle_degrees",
+                 observed_angle_degrees, "(0, 90]");
+  require_option(erode_rings >= 0 && erode_rings <= 100, "erode_rings", erode_rings, "[0, 100]");
+}
 
 namespace {
 
@@ -102,7 +109,7 @@ std::size_t drop_unanchored(const TriMesh& mesh, std::vector<std::uint8_t>& is_f
 std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
                                                    const VertexFields& fields,
                                                    const UnobservedDisplacementOptions& options) {
-  MVFLOW_CHECK(options.check(), "unobserved displacement: observed angle outside (0, 90]");
+  options.check();
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "poorly_observed_vertices: fields not sized for the mesh");
   const double cos_observed = std::cos(options.observed_angle_degrees * std::numbers::pi / 180.0);
   std::vector<std::uint8_t> poor(fields.size(), 1);

@@ -40,7 +40,8 @@ struct UnobservedDisplacementOptions {
   //! cap, 2 or more pulled it in; README, "Quality"). ≥ 0.
   int erode_rings = 1;
 
-  bool check() const { return observed_angle_degrees > 0 && observed_angle_degrees <= 90 && erode_rings >= 0; }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! One flag per vertex: 1 unless the last iteration gave it a speed (kSpeedDefined) and, with

@@ -5,12 +5,19 @@
 #include <vector>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 
+void UnobservedSpeedOptions::check() const {
+  require_option(max_rings >= 1, "max_rings", max_rings, ">= 1");
+  require_option(weak_angle_degrees > 0 && weak_angle_degrees <= 90, "weak_angle_degrees", weak_angle_degrees,
+                 "(0, 90]");
+}
+
 std::size_t demote_weakly_seen(const TriMesh& mesh, const std::vector<PhotoView>& views,
                                const UnobservedSpeedOptions& options, VertexFields& fields) {
-  MVFLOW_CHECK(options.check(), "unobserved speed options out of range");
+  options.check();
   if (!options.fill || options.weak_angle_degrees >= 90.0) return 0;
   const double cos_weak = std::cos(options.weak_angle_degrees * std::numbers::pi / 180.0);
   std::size_t demoted = 0;
@@ -35,7 +42,7 @@ std::size_t demote_weakly_seen(const TriMesh& mesh, const std::vector<PhotoView>
 
 std::size_t fill_unobserved_speeds(const TriMesh& mesh, const UnobservedSpeedOptions& options,
                                    std::span<const double> rate, VertexFields& fields) {
-  MVFLOW_CHECK(options.check(), "unobserved speed options out of range");
+  options.check();
   MVFLOW_CHECK(fields.size() == mesh.n_vertices() && rate.size() == mesh.n_vertices(),
                "fill_unobserved_speeds: fields or rates are not sized for the mesh");
   if (!options.fill) return 0;

@@ -29,7 +29,8 @@ struct UnobservedSpeedOptions {
   //! normal (degrees; seen only obliquely, its g and ∇g are unreliable). 90: only vertices
   //! without a speed.
   double weak_angle_degrees = 90.0;
-  bool check() const { return max_rings >= 1 && weak_angle_degrees > 0 && weak_angle_degrees <= 90; }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! Clears kSpeedDefined (and the speed) of the vertices whose views all lie beyond

@@ -5,8 +5,19 @@
 #include <numbers>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
+
+void VisibilityOptions::check() const {
+  require_option(max_angle_degrees > 0 && max_angle_degrees <= 90, "max_angle_degrees", max_angle_degrees, "(0, 90]");
+  require_option(preferred_angle_degrees > 0 && preferred_angle_degrees <= 90, "preferred_angle_degrees",
+                 preferred_angle_degrees, "(0, 90]");
+  require_option(min_views >= 2 && min_views <= 1000, "min_views", min_views, "[2, 1000]");
+  require_option(half_patch >= 0, "half_patch", half_patch, ">= 0");
+  require_option(ray_offset >= 0, "ray_offset", ray_offset, ">= 0");
+  require_option(max_views == 0 || max_views >= 2, "max_views", max_views, "0 (all) or >= 2");
+}
 
 namespace {
 
@@ -40,7 +51,7 @@ std::uint16_t select_views(const VisibilityOptions& options, double cos_preferre
 void compute_visibility(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
                         const SurfaceQuery& surface, double mean_edge, const VisibilityOptions& options,
                         VertexFields& fields) {
-  MVFLOW_CHECK(options.check(), "visibility options out of range");
+  options.check();
   MVFLOW_CHECK(fields.view_capacity >= views.size(), "vertex fields sized for fewer views");
   const double cos_max = std::cos(options.max_angle_degrees * std::numbers::pi / 180.0);
   const double offset = options.ray_offset * mean_edge;

@@ -33,11 +33,8 @@ struct VisibilityOptions {
   //! to the normal (the smallest angle; the lower view index on a tie), in view order. 0 keeps
   //! all (the thesis).
   int max_views = 0;
-  bool check() const {
-    return max_angle_degrees > 0 && max_angle_degrees <= 90 && preferred_angle_degrees > 0 &&
-           preferred_angle_degrees <= 90 && min_views >= 2 && half_patch >= 0 && ray_offset >= 0 && max_views >= 0 &&
-           (max_views == 0 || max_views >= 2);
-  }
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! Fills visible_views / visible_count for the vertices of \p vertices, in view order.

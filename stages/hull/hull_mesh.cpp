@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "engine/model/surface_query.h"
 #include "stages/hull/isotropic_remeshing.h"
 #include "stages/hull/mesh_cleanup.h"
@@ -31,13 +32,12 @@ double surface_area(const IndexedMesh& mesh) {
 }  // namespace
 
 void HullMeshOptions::check() const {
-  carving.check();
-  extraction.check();
-  if (vertices < 20) throw InputError("hull: the target vertex count must be at least 20");
-  if (!(std::isfinite(smoothing) && smoothing >= 0.0 && smoothing <= 100.0))
-    throw InputError("hull: the smoothing must be in [0, 100] grid samples");
-  if (!(neck_edge >= 0.0 && neck_edge <= 0.8)) throw InputError("hull: the neck edge fraction must be in [0, 0.8]");
-  if (remeshing_iterations < 2) throw InputError("hull: the number of remeshing iterations must be at least 2");
+  check_member(carving, "carving");
+  check_member(extraction, "extraction");
+  require_option(vertices >= 20, "vertices", vertices, ">= 20");
+  require_option(smoothing >= 0.0 && smoothing <= 100.0, "smoothing", smoothing, "[0, 100] grid samples");
+  require_option(neck_edge >= 0.0 && neck_edge <= 0.8, "neck_edge", neck_edge, "[0, 0.8]");
+  require_option(remeshing_iterations >= 2, "remeshing_iterations", remeshing_iterations, ">= 2");
 }
 
 HullMeshResult make_hull_mesh(const std::vector<Camera>& cameras, const std::vector<Mask>& silhouettes,

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 
@@ -107,9 +108,9 @@ class Extractor {
 }  // namespace
 
 void IsoSurfaceOptions::check() const {
-  if (!std::isfinite(level)) throw InputError("iso-surface: the level must be finite");
-  if (!(min_edge_fraction >= 0.0 && min_edge_fraction <= 0.25))
-    throw InputError("iso-surface: the minimum edge fraction must be in [0, 0.25]");
+  require_option(std::isfinite(level), "level", level, "a finite number");
+  require_option(min_edge_fraction >= 0.0 && min_edge_fraction <= 0.25, "min_edge_fraction", min_edge_fraction,
+                 "[0, 0.25]");
 }
 
 IndexedMesh extract_iso_surface(const ScalarGrid& grid, const IsoSurfaceOptions& options) {

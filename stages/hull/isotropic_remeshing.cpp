@@ -11,8 +11,9 @@
 #include <vector>
 
 #include "engine/model/error.h"
-#include "stages/topology/mesh_edit.h"
 #include "engine/model/one_ring.h"  // point, is_degenerate
+#include "engine/model/option_check.h"
+#include "stages/topology/mesh_edit.h"
 
 namespace mvflow {
 
@@ -40,9 +41,7 @@ std::size_t split_long_edges(TriMesh& mesh, double high) {
     for (int id = 0; id < n_edges; ++id) {
       const EdgeHandle e(id);
       if (!(mesh.calc_edge_length(e) > high)) continue;
-      const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
-      const auto mid = 0.5 * (mesh.point(mesh.from_vertex_handle(h)) + mesh.point(mesh.to_vertex_handle(h)));
-      mesh.split_edge(e, mesh.add_vertex(mid));
+      detail::split_at_midpoint(mesh, e);
       ++splits;
       again = true;
     }
@@ -55,19 +54,7 @@ std::size_t split_long_edges(TriMesh& mesh, double high) {
 //! vertex non-degenerate and facing the way it did?
 bool collapse_keeps_shape(const TriMesh& mesh, HalfedgeHandle h, double high) {
   const VertexHandle from = mesh.from_vertex_handle(h), to = mesh.to_vertex_handle(h);
-  const Eigen::Vector3d p = point(mesh, from), target = point(mesh, to);
-  for (auto out = mesh.cvoh_iter(from); out.is_valid(); ++out) {
-    const VertexHandle q = mesh.to_vertex_handle(*out);
-    if (q == to) continue;
-    const Eigen::Vector3d pq = point(mesh, q);
-    if ((pq - target).norm() > high) return false;
-    if (!mesh.face_handle(*out).is_valid()) continue;
-    const VertexHandle r = mesh.to_vertex_handle(mesh.next_halfedge_handle(*out));  // face (from, q, r)
-    if (r == to) continue;                                                          // vanishes with the edge
-    const Eigen::Vector3d pr = point(mesh, r);
-    if (!keeps_facing(target, pq, pr, (pq - p).cross(pr - p))) return false;
-  }
-  return true;
+  return detail::check_collapse_ring(mesh, from, to, point(mesh, to), high) == detail::CollapseVerdict::Ok;
 }
 
 std::size_t collapse_short_edges(TriMesh& mesh, double low, double high) {
@@ -149,9 +136,8 @@ void relax_and_project(TriMesh& mesh, const SurfaceQuery& reference) {
 }  // namespace
 
 void IsotropicRemeshingOptions::check() const {
-  if (!(std::isfinite(target_edge) && target_edge > 0.0))
-    throw InputError("isotropic remeshing: the target edge length must be positive and finite");
-  if (iterations < 0) throw InputError("isotropic remeshing: the number of iterations must be >= 0");
+  require_option(target_edge > 0.0 && std::isfinite(target_edge), "target_edge", target_edge, "> 0 and finite");
+  require_option(iterations >= 0, "iterations", iterations, ">= 0");
 }
 
 double edge_length_for_vertices(double area, std::size_t vertices) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 
@@ -81,8 +82,8 @@ double box_distance(const BoundingBox& box, const Eigen::Vector3d& X) {
 }  // namespace
 
 void VisualHullOptions::check() const {
-  if (resolution < 8 || resolution > 1024) throw InputError("visual hull: the resolution must be in 8..1024");
-  if (min_views < 1) throw InputError("visual hull: the minimum number of views must be at least 1");
+  require_option(resolution >= 8 && resolution <= 1024, "resolution", resolution, "[8, 1024]");
+  require_option(min_views >= 1, "min_views", min_views, ">= 1");
 }
 
 float SilhouetteDistance::sample(double u, double v) const {

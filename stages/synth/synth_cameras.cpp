@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 
@@ -20,17 +21,17 @@ Eigen::Vector3d direction(double azimuth, double elevation) {
 }  // namespace
 
 void RigOptions::check() const {
-  if (views < 1 || views > 1000) throw InputError("cameras: the number of views must be in 1..1000");
-  if (!(distance > 1.0 && distance < 1e6)) throw InputError("cameras: the distance must be > 1 object radius");
-  if (!(elevation_min >= -85 && elevation_max <= 85 && elevation_min <= elevation_max))
-    throw InputError("cameras: the elevation range must be MIN,MAX with -85 <= MIN <= MAX <= 85 degrees");
-  if (width < 8 || width > 8192 || height < 8 || height > 8192)
-    throw InputError("cameras: the image width and height must be in 8..8192 pixels");
-  if (focal == 0.0) {
-    if (!(fov >= 1 && fov <= 170)) throw InputError("cameras: the field of view must be in 1..170 degrees");
-  } else if (!(focal > 0 && std::isfinite(focal))) {
-    throw InputError("cameras: the focal length must be a positive number of pixels");
-  }
+  require_option(views >= 1 && views <= 1000, "views", views, "[1, 1000]");
+  require_option(distance > 1.0 && distance < 1e6, "distance", distance, "(1, 1e6) object radii");
+  require_option(elevation_min >= -85 && elevation_min <= elevation_max, "elevation_min", elevation_min,
+                 "[-85, elevation_max] degrees");
+  require_option(elevation_max <= 85, "elevation_max", elevation_max, "<= 85 degrees");
+  require_option(width >= 8 && width <= 8192, "width", width, "[8, 8192] pixels");
+  require_option(height >= 8 && height <= 8192, "height", height, "[8, 8192] pixels");
+  if (focal == 0.0)
+    require_option(fov >= 1 && fov <= 170, "fov", fov, "[1, 170] degrees");
+  else
+    require_option(focal > 0 && std::isfinite(focal), "focal", focal, "0 (from fov) or > 0 pixels");
 }
 
 double RigOptions::focal_pixels() const {

@@ -11,6 +11,7 @@
 
 #include "engine/model/bounding_box.h"
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/hull/mesh_cleanup.h"
 #include "stages/synth/synth_render.h"
 #include "stages/synth/synth_texture.h"
@@ -99,9 +100,9 @@ void push_along_normals(IndexedMesh& mesh, const std::vector<double>& distances)
 }  // namespace
 
 void InitialMeshOptions::check() const {
-  if (!(amount >= 0 && amount <= 0.5)) throw InputError("initial mesh: the displacement D must be in [0, 0.5]");
-  if (vertices < 20) throw InputError("initial mesh: the vertex count must be at least 20");
-  if (!(smoothing >= 0 && smoothing <= 0.5)) throw InputError("initial mesh: the smoothing length must be in [0, 0.5]");
+  require_option(amount >= 0 && amount <= 0.5, "amount", amount, "[0, 0.5]");
+  require_option(vertices >= 20, "vertices", vertices, ">= 20");
+  require_option(smoothing >= 0 && smoothing <= 0.5, "smoothing", smoothing, "[0, 0.5]");
 }
 
 int smooth_keeping_volume(IndexedMesh& mesh, double length) {

@@ -8,6 +8,7 @@
 
 #include "engine/model/bounding_box.h"
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "engine/model/primitives.h"
 
 namespace mvflow {
@@ -37,10 +38,10 @@ IndexedMesh star_shaped(const BuiltinShapeOptions& options, double (*base_radius
 }  // namespace
 
 void BuiltinShapeOptions::check() const {
-  if (level < 1 || level > 7) throw InputError("shape: the subdivision level must be in 1..7");
-  if (!(amplitude >= 0 && amplitude <= 0.5)) throw InputError("shape: the bump amplitude must be in [0, 0.5]");
-  if (!(frequency > 0 && frequency <= 40)) throw InputError("shape: the bump frequency must be in (0, 40]");
-  if (!(waist >= 0.2 && waist <= 1)) throw InputError("shape: the peanut waist must be in [0.2, 1]");
+  require_option(level >= 1 && level <= 7, "level", level, "[1, 7]");
+  require_option(amplitude >= 0 && amplitude <= 0.5, "amplitude", amplitude, "[0, 0.5]");
+  require_option(frequency > 0 && frequency <= 40, "frequency", frequency, "(0, 40]");
+  require_option(waist >= 0.2 && waist <= 1, "waist", waist, "[0.2, 1]");
 }
 
 IndexedMesh make_bumpy_sphere(const BuiltinShapeOptions& options) {

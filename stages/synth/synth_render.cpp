@@ -8,6 +8,8 @@
 #include <utility>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
+#include "engine/model/supersample.h"
 
 namespace mvflow {
 
@@ -41,13 +43,13 @@ class RowNoise {
 }  // namespace
 
 void RenderOptions::check() const {
-  if (supersample < 1 || supersample > 8) throw InputError("render: supersampling must be in 1..8");
-  if (!(ambient >= 0 && diffuse >= 0 && ambient + diffuse <= 4))
-    throw InputError("render: ambient and diffuse must be >= 0 (sum at most 4)");
-  if (!light.allFinite() || !(light.norm() > 0)) throw InputError("render: the light direction must be a non-zero vector");
-  if (!(specular >= 0 && specular <= 1)) throw InputError("render: the specular weight must be in [0, 1]");
-  if (!(shininess >= 1 && shininess <= 10000)) throw InputError("render: the specular exponent must be in [1, 10000]");
-  if (!(noise >= 0 && noise <= 1)) throw InputError("render: the noise sigma must be in [0, 1]");
+  require_option(supersample >= 1 && supersample <= 8, "supersample", supersample, "[1, 8]");
+  require_option(ambient >= 0, "ambient", ambient, ">= 0");
+  require_option(diffuse >= 0 && ambient + diffuse <= 4, "diffuse", diffuse, ">= 0 with ambient + diffuse <= 4");
+  require_option(light.allFinite() && light.norm() > 0, "light", light.transpose(), "a finite non-zero direction");
+  require_option(specular >= 0 && specular <= 1, "specular", specular, "[0, 1]");
+  require_option(shininess >= 1 && shininess <= 10000, "shininess", shininess, "[1, 10000]");
+  require_option(noise >= 0 && noise <= 1, "noise", noise, "[0, 1]");
 }
 
 std::vector<Eigen::Vector3d> vertex_normals(const IndexedMesh& mesh) {
@@ -136,12 +138,7 @@ void SynthRenderer::render_rows(const Camera& camera, std::size_t view_index, in
     RowNoise noise(mix_seed(mix_seed(options_.seed, view_index), static_cast<std::uint64_t>(y)));
     for (int x = 0; x < image.width(); ++x) {
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-          // Sub-pixel centres; pixel (x, y) covers [x − ½, x + ½) × [y − ½, y + ½) (SPEC §2).
-          const Ray ray = camera.ray(x + (i + 0.5) / n - 0.5, y + (j + 0.5) / n - 0.5);
-          sum += trace(ray.origin, ray.direction);
-        }
+      for_each_subpixel_ray(camera, x, y, n, [&](const Ray& ray) { sum += trace(ray.origin, ray.direction); });
       Eigen::Vector3f colour = sum * weight;
       if (options_.noise > 0)
         for (int c = 0; c < 3; ++c) colour[c] += static_cast<float>(options_.noise * noise.next());

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "stages/hull/hull_mesh.h"
 
 namespace mvflow {
@@ -46,14 +47,14 @@ IndexedMesh hull_initial_mesh(const SynthScene& scene, const SurfaceQuery& truth
 }  // namespace
 
 void SynthOptions::check() const {
-  if (!(feature_size > 0 && feature_size <= 100)) throw InputError("synth: the feature size must be in (0, 100]");
-  if (octaves < 1 || octaves > 8) throw InputError("synth: octaves must be in 1..8");
-  if (!(background_radius > 1 && background_radius < 1e6))
-    throw InputError("synth: the background radius must be > 1 object radius");
-  if (!(bbox_margin >= 0 && bbox_margin <= 10)) throw InputError("synth: the bounding-box margin must be in [0, 10]");
-  render.check();
-  rig.check();
-  init.check();
+  require_option(feature_size > 0 && feature_size <= 100, "feature_size", feature_size, "(0, 100]");
+  require_option(octaves >= 1 && octaves <= 8, "octaves", octaves, "[1, 8]");
+  require_option(background_radius > 1 && background_radius < 1e6, "background_radius", background_radius,
+                 "(1, 1e6) object radii");
+  require_option(bbox_margin >= 0 && bbox_margin <= 10, "bbox_margin", bbox_margin, "[0, 10]");
+  check_member(render, "render");
+  check_member(rig, "rig");
+  check_member(init, "init");
 }
 
 const std::vector<std::string>& builtin_object_names() {

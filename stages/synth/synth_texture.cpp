@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 
 namespace mvflow {
 
@@ -52,9 +53,8 @@ std::uint64_t mix_seed(std::uint64_t a, std::uint64_t b) {
 }
 
 void SolidTextureOptions::check() const {
-  if (!(feature_size > 0) || !std::isfinite(feature_size))
-    throw InputError("solid texture: feature size must be a positive number");
-  if (octaves < 1 || octaves > 8) throw InputError("solid texture: octaves must be in 1..8");
+  require_option(feature_size > 0 && std::isfinite(feature_size), "feature_size", feature_size, "> 0 and finite");
+  require_option(octaves >= 1 && octaves <= 8, "octaves", octaves, "[1, 8]");
 }
 
 SolidTexture::SolidTexture(const SolidTextureOptions& options)

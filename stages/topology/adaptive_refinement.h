@@ -32,9 +32,10 @@ struct AdaptiveRefinementOptions {
   //! preset. In [0, 1). README, "Defaults and differences", for the measurement.
   double min_growth = 0.1;
 
-  //! True when every value is finite, curvature_factor > 0, min_edge_relative ≥ 0,
-  //! min_edge_pixels ≥ 0 and 0 ≤ min_growth < 1.
-  bool check() const;
+  //! Every value finite, curvature_factor > 0, min_edge_relative ≥ 0, min_edge_pixels ≥ 0 and
+  //! 0 ≤ min_growth < 1.
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! What refine_adaptively did.

@@ -9,49 +9,23 @@
 #include <Eigen/Geometry>
 
 #include "engine/model/error.h"
-#include "stages/topology/mesh_edit.h"
 #include "engine/model/one_ring.h"
+#include "engine/model/option_check.h"
+#include "stages/topology/mesh_edit.h"
 
 namespace mvflow {
 
-bool RemeshingOptions::check() const {
-  return std::isfinite(split_factor) && std::isfinite(collapse_factor) && collapse_factor > 0.0 &&
-         split_factor >= 2.0 * collapse_factor;
+void RemeshingOptions::check() const {
+  require_option(collapse_factor > 0.0 && std::isfinite(collapse_factor), "collapse_factor", collapse_factor,
+                 "> 0 and finite");
+  require_option(split_factor >= 2.0 * collapse_factor && std::isfinite(split_factor), "split_factor", split_factor,
+                 ">= 2 × collapse_factor and finite");
 }
 
 namespace {
 
 using VertexHandle = TriMesh::VertexHandle;
 using HalfedgeHandle = TriMesh::HalfedgeHandle;
-
-enum class Verdict { Ok, FoldOver, LongEdge };
-
-//! Would moving both ends of the collapsed edge to \p target keep every surviving face around
-//! \p moved (one of the two ends) non-degenerate and unflipped, and every edge at it ≤ \p max_edge?
-//! Unflipped: the face's new normal has a positive dot product with its old normal and with
-//! \p ring_normal, the area-weighted normal of both ends' rings before the collapse. The second
-//! test stops a face from turning over in several steps of < 90° each (seen when most edges of a
-//! sphere were collapse candidates). \p other is the other end; faces containing both ends vanish
-//! with the collapse and are skipped.
-Verdict check_ring(const TriMesh& mesh, VertexHandle moved, VertexHandle other, const Eigen::Vector3d& target,
-                   const Eigen::Vector3d& ring_normal, double max_edge) {
-  const Eigen::Vector3d p = detail::point(mesh, moved);
-  for (auto h = mesh.cvoh_iter(moved); h.is_valid(); ++h) {
-    const VertexHandle q = mesh.to_vertex_handle(*h);
-    if (q == other) continue;
-    const Eigen::Vector3d pq = detail::point(mesh, q);
-    if ((pq - target).norm() > max_edge) return Verdict::LongEdge;
-    if (!mesh.face_handle(*h).is_valid()) continue;
-    const VertexHandle r = mesh.to_vertex_handle(mesh.next_halfedge_handle(*h));  // face (moved, q, r)
-    if (r == other) continue;
-    const Eigen::Vector3d pr = detail::point(mesh, r);
-    const Eigen::Vector3d before = (pq - p).cross(pr - p);
-    const Eigen::Vector3d after = (pq - target).cross(pr - target);
-    if (detail::is_degenerate(target, pq, pr, after) || !(before.dot(after) > 0.0) || !(ring_normal.dot(after) > 0.0))
-      return Verdict::FoldOver;
-  }
-  return Verdict::Ok;
-}
 
 void split_long_edges(TriMesh& mesh, double upper, RemeshingResult& result) {
   // The edges too long at the start, each split once (SPEC §5: one pass), longest first (ties in
@@ -63,12 +37,9 @@ void split_long_edges(TriMesh& mesh, double upper, RemeshingResult& result) {
     if (const double l = mesh.calc_edge_length(e); l > upper) long_edges.emplace_back(-l, e.idx());
   std::sort(long_edges.begin(), long_edges.end());
   for (const auto& [negative_length, id] : long_edges) {
-    const TriMesh::EdgeHandle e(id);
-    const auto h = mesh.halfedge_handle(e, 0);
-    const auto mid = 0.5 * (mesh.point(mesh.from_vertex_handle(h)) + mesh.point(mesh.to_vertex_handle(h)));
     // Splitting keeps e's handle (as one half) and only adds elements, so the handles still
     // waiting in long_edges stay valid.
-    mesh.split_edge(e, mesh.add_vertex(mid));
+    detail::split_at_midpoint(mesh, TriMesh::EdgeHandle(id));
     ++result.splits;
   }
 }
@@ -99,10 +70,13 @@ void collapse_short_edges(TriMesh& mesh, double lower, double upper, RemeshingRe
                                        ? detail::point(mesh, to)
                                        : 0.5 * (detail::point(mesh, from) + detail::point(mesh, to));
     const Eigen::Vector3d ring_normal = detail::area_normal(mesh, from) + detail::area_normal(mesh, to);
-    Verdict verdict = check_ring(mesh, from, to, target, ring_normal, upper);
-    if (verdict == Verdict::Ok) verdict = check_ring(mesh, to, from, target, ring_normal, upper);
-    if (verdict != Verdict::Ok) {
-      ++(verdict == Verdict::FoldOver ? result.rejected_fold_over : result.rejected_long_edge);
+    // Unflipped also against both rings' normal before the collapse: that stops a face from turning
+    // over in several steps of < 90° each (seen when most edges of a sphere were candidates).
+    using detail::CollapseVerdict;
+    CollapseVerdict verdict = detail::check_collapse_ring(mesh, from, to, target, upper, &ring_normal);
+    if (verdict == CollapseVerdict::Ok) verdict = detail::check_collapse_ring(mesh, to, from, target, upper, &ring_normal);
+    if (verdict != CollapseVerdict::Ok) {
+      ++(verdict == CollapseVerdict::FoldOver ? result.rejected_fold_over : result.rejected_long_edge);
       continue;
     }
     mesh.collapse(h);
@@ -116,7 +90,7 @@ void collapse_short_edges(TriMesh& mesh, double lower, double upper, RemeshingRe
 }  // namespace
 
 RemeshingResult remesh_edges(TriMesh& mesh, double reference_edge, const RemeshingOptions& options) {
-  MVFLOW_CHECK(options.check(), "remesh_edges: invalid RemeshingOptions");
+  options.check();
   MVFLOW_CHECK(std::isfinite(reference_edge) && reference_edge > 0.0,
                "remesh_edges: the reference edge e_S must be positive and finite");
   const double upper = options.split_factor * reference_edge;

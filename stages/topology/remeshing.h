@@ -14,9 +14,10 @@ struct RemeshingOptions {
   //! b_l = collapse_factor · e_S: edges shorter than this are collapsed. 0.8: thesis B.7 (4/5).
   double collapse_factor = 0.8;
 
-  //! True when both factors are finite, collapse_factor > 0 and split_factor ≥ 2·collapse_factor
-  //! (so the halves of a split edge, longer than b_u/2, are never collapse candidates).
-  bool check() const;
+  //! Both factors finite, collapse_factor > 0 and split_factor ≥ 2·collapse_factor (so the halves
+  //! of a split edge, longer than b_u/2, are never collapse candidates).
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! What remesh_edges did. Rejected collapses are counted once per reason (the first that failed).

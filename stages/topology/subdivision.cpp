@@ -9,6 +9,8 @@
 
 #include "engine/model/error.h"
 #include "engine/model/one_ring.h"
+#include "engine/model/option_check.h"
+#include "stages/topology/red_green.h"
 #include "stages/topology/subdivision_refine.h"
 
 namespace mvflow {
@@ -31,44 +33,14 @@ struct RefinementPlan {
   std::size_t new_vertices = 0;
 };
 
-bool face_is_red(const TriMesh& mesh, HalfedgeHandle h, const std::vector<std::uint8_t>& red) {
-  const FaceHandle f = mesh.face_handle(h);
-  return f.is_valid() && red[f.idx()];
-}
-
-bool edge_touches_red(const TriMesh& mesh, EdgeHandle e, const std::vector<std::uint8_t>& red) {
-  return face_is_red(mesh, mesh.halfedge_handle(e, 0), red) || face_is_red(mesh, mesh.halfedge_handle(e, 1), red);
-}
-
-//! Red–green closure: a face with two or three split edges becomes red, which splits its third
-//! edge too; repeat until every non-red face has at most one split edge.
-std::vector<std::uint8_t> close_red_faces(const TriMesh& mesh, std::vector<std::uint8_t> red) {
-  std::vector<FaceHandle> work;
-  for (auto f : mesh.faces())
-    if (red[f.idx()])
-      for (auto g : mesh.ff_range(f))
-        if (!red[g.idx()]) work.push_back(g);
-  while (!work.empty()) {
-    const FaceHandle f = work.back();
-    work.pop_back();
-    if (red[f.idx()]) continue;
-    int split = 0;
-    for (auto e : mesh.fe_range(f)) split += edge_touches_red(mesh, e, red) ? 1 : 0;
-    if (split < 2) continue;
-    red[f.idx()] = 1;
-    for (auto g : mesh.ff_range(f))
-      if (!red[g.idx()]) work.push_back(g);
-  }
-  return red;
-}
-
 RefinementPlan plan_refinement(const TriMesh& mesh, const std::vector<std::uint8_t>* selected) {
   RefinementPlan plan;
-  plan.red = selected ? close_red_faces(mesh, *selected) : std::vector<std::uint8_t>(mesh.n_faces(), 1);
+  plan.red = selected ? *selected : std::vector<std::uint8_t>(mesh.n_faces(), 1);
+  if (selected) detail::close_red_faces(mesh, plan.red);
   plan.edge_vertex.assign(mesh.n_edges(), -1);
   plan.edge_smooth.assign(mesh.n_edges(), 0);
   for (auto e : mesh.edges()) {
-    if (!edge_touches_red(mesh, e, plan.red)) continue;
+    if (!detail::edge_is_split(mesh, e, plan.red)) continue;
     plan.edge_vertex[e.idx()] = static_cast<std::int64_t>(mesh.n_vertices() + plan.new_vertices++);
     bool all_red = true;
     for (int side = 0; side < 2; ++side) {
@@ -105,31 +77,17 @@ std::vector<TriMesh::Point> new_positions(const TriMesh& mesh, const RefinementP
   return points;
 }
 
-//! Adds the children of \p f (corners v_i, new vertices m_i on the edge from v_i to v_{i+1},
-//! −1 if not split) to \p out; returns how many.
-int add_children(TriMesh& out, std::array<int, 3> v, std::array<std::int64_t, 3> m) {
-  auto add = [&out](std::int64_t a, std::int64_t b, std::int64_t c) {
-    const auto f = out.add_face(VertexHandle(static_cast<int>(a)), VertexHandle(static_cast<int>(b)),
-                                VertexHandle(static_cast<int>(c)));
+//! Adds the children of the face with corners \p v and new vertices \p m (red_green.h) to \p out;
+//! returns how many.
+int add_children(TriMesh& out, const detail::Corners& v, const detail::Corners& m) {
+  const detail::ChildFaces children = detail::child_faces(v, m);
+  MVFLOW_CHECK(children.count > 0, "subdivide: red-green closure left a face with two split edges");
+  for (int k = 0; k < children.count; ++k) {
+    const detail::Corners& t = children.faces[k];
+    const auto f = out.add_face(VertexHandle(t[0]), VertexHandle(t[1]), VertexHandle(t[2]));
     MVFLOW_CHECK(f.is_valid(), "subdivide: the refined mesh is not manifold (is the input?)");
-  };
-  const int split = (m[0] >= 0) + (m[1] >= 0) + (m[2] >= 0);
-  if (split == 3) {
-    add(v[0], m[0], m[2]);
-    add(v[1], m[1], m[0]);
-    add(v[2], m[2], m[1]);
-    add(m[0], m[1], m[2]);
-    return 4;
   }
-  if (split == 1) {  // green: from the split vertex to the opposite corner
-    const int i = m[0] >= 0 ? 0 : m[1] >= 0 ? 1 : 2;
-    add(v[i], m[i], v[(i + 2) % 3]);
-    add(m[i], v[(i + 1) % 3], v[(i + 2) % 3]);
-    return 2;
-  }
-  MVFLOW_CHECK(split == 0, "subdivide: red-green closure left a face with two split edges");
-  add(v[0], v[1], v[2]);
-  return 1;
+  return children.count;
 }
 
 TriMesh build_refined(const TriMesh& mesh, const RefinementPlan& plan, const std::vector<TriMesh::Point>& points,
@@ -143,11 +101,10 @@ TriMesh build_refined(const TriMesh& mesh, const RefinementPlan& plan, const std
     const HalfedgeHandle h2 = mesh.halfedge_handle(f);
     const HalfedgeHandle h0 = mesh.next_halfedge_handle(h2);
     const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
-    const std::array<int, 3> v{mesh.from_vertex_handle(h0).idx(), mesh.from_vertex_handle(h1).idx(),
-                               mesh.from_vertex_handle(h2).idx()};
-    const std::array<std::int64_t, 3> m{plan.edge_vertex[mesh.edge_handle(h0).idx()],
-                                        plan.edge_vertex[mesh.edge_handle(h1).idx()],
-                                        plan.edge_vertex[mesh.edge_handle(h2).idx()]};
+    const detail::Corners v{mesh.from_vertex_handle(h0).idx(), mesh.from_vertex_handle(h1).idx(),
+                            mesh.from_vertex_handle(h2).idx()};
+    auto new_vertex = [&](HalfedgeHandle h) { return static_cast<int>(plan.edge_vertex[mesh.edge_handle(h).idx()]); };
+    const detail::Corners m{new_vertex(h0), new_vertex(h1), new_vertex(h2)};
     const int children = add_children(out, v, m);
     if (selected) child_selected.insert(child_selected.end(), children, (*selected)[f.idx()]);
   }
@@ -199,8 +156,10 @@ std::vector<std::uint8_t> boundary_edges(const TriMesh& mesh) {
 
 }  // namespace subdivision_detail
 
-bool SubdivisionOptions::check() const {
-  return iterations >= 0 && sharp_angle_degrees >= 0.0 && sharp_angle_degrees <= 180.0;
+void SubdivisionOptions::check() const {
+  require_option(iterations >= 0, "iterations", iterations, ">= 0");
+  require_option(sharp_angle_degrees >= 0.0 && sharp_angle_degrees <= 180.0, "sharp_angle_degrees",
+                 sharp_angle_degrees, "[0, 180]");
 }
 
 std::vector<std::uint8_t> sharp_edges_by_angle(const TriMesh& mesh, double angle_degrees) {
@@ -253,7 +212,7 @@ TriMesh butterfly_subdivide(const TriMesh& mesh, const std::vector<std::uint8_t>
 TriMesh subdivide(const TriMesh& mesh, const SubdivisionOptions& options,
                   const std::vector<std::uint8_t>* selected_faces) {
   using namespace subdivision_detail;
-  MVFLOW_CHECK(options.check(), "subdivide: invalid SubdivisionOptions");
+  options.check();
   MVFLOW_CHECK(!selected_faces || selected_faces->size() == mesh.n_faces(),
                "subdivide: selected_faces needs one flag per face (" + std::to_string(mesh.n_faces()) + ")");
   StepOutput state{mesh, selected_faces ? *selected_faces : std::vector<std::uint8_t>{}, {}};

@@ -26,7 +26,8 @@ struct SubdivisionOptions {
   //! default of modelling tools (Blender's auto-smooth angle).
   double sharp_angle_degrees = 30.0;
 
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 //! Subdivides \p mesh options.iterations times with options.scheme; each step quadrisects

@@ -9,12 +9,16 @@
 
 #include "engine/model/error.h"
 #include "engine/model/one_ring.h"
+#include "engine/model/option_check.h"
 #include "stages/topology/self_intersections.h"
 
 namespace mvflow {
 
-bool UntanglingOptions::check() const {
-  return max_rounds >= 0 && ring >= 0 && steps >= 1 && std::isfinite(fraction) && fraction > 0.0 && fraction <= 1.0;
+void UntanglingOptions::check() const {
+  require_option(max_rounds >= 0, "max_rounds", max_rounds, ">= 0");
+  require_option(ring >= 0, "ring", ring, ">= 0");
+  require_option(steps >= 1, "steps", steps, ">= 1");
+  require_option(fraction > 0.0 && fraction <= 1.0, "fraction", fraction, "(0, 1]");
 }
 
 namespace {
@@ -62,7 +66,7 @@ void umbrella_step(TriMesh& mesh, const std::vector<std::uint32_t>& region, doub
 }  // namespace
 
 UntanglingResult untangle(TriMesh& mesh, const UntanglingOptions& options) {
-  MVFLOW_CHECK(options.check(), "untangle: invalid UntanglingOptions");
+  options.check();
   UntanglingResult result;
   auto pairs = self_intersecting_pairs(mesh);
   result.crossing_pairs_before = pairs.size();

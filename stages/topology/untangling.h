@@ -20,7 +20,8 @@ struct UntanglingOptions {
   int steps = 5;
   double fraction = 0.5;
 
-  bool check() const;
+  //! \throw OptionError naming the first field out of range, its value and its valid values.
+  void check() const;
 };
 
 struct UntanglingResult {

@@ -142,9 +142,11 @@ RefineOptions refine_options(const std::string& preset_name, const py::kwargs& k
   CLI::App app;
   cli::add_refine_options(app);
   parse(app, flags_of(kwargs), "refine options");
-  RefineOptions options = cli::resolve_refine_options(preset_name, app);
-  options.check();  // InputError now, not a failed run later
-  return options;
+  try {
+    return cli::resolve_refine_options(preset_name, app);  // checked: InputError now, not a failed run later
+  } catch (const CLI::ParseError& e) {
+    throw InputError(std::string("refine options: ") + e.what());
+  }
 }
 
 std::shared_ptr<spdlog::logger> warnings_logger() {
