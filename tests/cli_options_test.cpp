@@ -106,8 +106,9 @@ TEST(RefineOptionTable, EachFlagSetsItsOwnFieldAndNothingElse) {
     const nlohmann::json after = options_after(arguments);
     EXPECT_NE(preset.at(entry.key), expected) << entry.flag << ": the case must differ from the default";
     EXPECT_EQ(after.at(entry.key), expected) << entry.flag;
-    for (const auto& [key, value] : preset.items())
+    for (const auto& [key, value] : preset.items()) {
       if (key != entry.key) EXPECT_EQ(after.at(key), value) << entry.flag << " also changed " << key;
+    }
   }
 }
 

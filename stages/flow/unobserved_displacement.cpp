@@ -189,7 +189,7 @@ DisplacementResult spread_displacement(TriMesh& mesh, std::span<const Eigen::Vec
     const double w = edge_weight(mesh, reference, e);
     const auto a = static_cast<std::size_t>(mesh.to_vertex_handle(mesh.halfedge_handle(e, 0)).idx());
     const auto b = static_cast<std::size_t>(mesh.to_vertex_handle(mesh.halfedge_handle(e, 1)).idx());
-    for (const auto [i, j] : {std::pair{a, b}, std::pair{b, a}}) {
+    for (const auto& [i, j] : {std::pair{a, b}, std::pair{b, a}}) {
       if (row[i] < 0) continue;
       triplets.emplace_back(row[i], row[i], w);
       if (row[j] >= 0) {
