@@ -6,7 +6,9 @@
 #
 #   mvflow_layer(<target> [HEADERS h...] SOURCES s... [PUBLIC dep...] [PRIVATE dep...])
 #     A static library for the current folder with alias mvflow::<name without "mvflow_">, its
-#     headers as a PUBLIC header file set (base: the project root), mvflow_warnings privately.
+#     headers as a header file set (base: the project root), mvflow_warnings privately. It is
+#     installed and exported as mvflow::<name> (tools/cmake/MvflowPackage.cmake), with its
+#     headers under include/mvflow/<folder>/, their includes prefixed (prefix_includes.cmake).
 #   mvflow_layer_clients(<target>...)
 #     Programs and helper libraries outside the layers (tools, tests, perf, fuzz) that the check
 #     covers too: their own folder plus the layers they link.
@@ -69,14 +71,47 @@ function(mvflow_layer target)
   add_library(${target} ${arg_SOURCES})
   string(REGEX REPLACE "^mvflow_" "" short ${target})
   add_library(mvflow::${short} ALIAS ${target})
+  file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
   if(arg_HEADERS)
-    target_sources(${target} PUBLIC FILE_SET HEADERS BASE_DIRS ${PROJECT_SOURCE_DIR} FILES ${arg_HEADERS})
+    # PRIVATE: an exported target must install its PUBLIC file sets as they are, and these are
+    # not what is installed (the prefixed copies below are).
+    target_sources(${target} PRIVATE FILE_SET HEADERS BASE_DIRS ${PROJECT_SOURCE_DIR} FILES ${arg_HEADERS})
+    _mvflow_prefixed_headers(${target} ${folder} "${arg_HEADERS}")
   endif()
   target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
-  target_link_libraries(${target} PUBLIC ${arg_PUBLIC} PRIVATE mvflow_warnings ${arg_PRIVATE})
-  file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
-  set_target_properties(${target} PROPERTIES MVFLOW_LAYER_FOLDER ${folder})
+  target_compile_features(${target} PUBLIC cxx_std_20)  # the headers need it in a host build too
+  # The warnings are this build's own: not part of the exported link interface.
+  target_link_libraries(${target} PUBLIC ${arg_PUBLIC} PRIVATE $<BUILD_INTERFACE:mvflow_warnings> ${arg_PRIVATE})
+  set_target_properties(${target} PROPERTIES MVFLOW_LAYER_FOLDER ${folder} EXPORT_NAME ${short})
+  install(TARGETS ${target} EXPORT mvflowTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
   set_property(GLOBAL APPEND PROPERTY MVFLOW_LAYERS ${target})
+endfunction()
+
+# The headers of layer \p target as installed: copies under <build>/include/mvflow/<folder>/ whose
+# includes read "mvflow/engine/...", remade on every build where a header changed (target
+# <target>_headers, part of ALL so that `cmake --install` finds them), installed to
+# include/mvflow/<folder>/.
+function(_mvflow_prefixed_headers target folder headers)
+  set(relative)
+  set(sources)
+  set(outputs)
+  foreach(header IN LISTS headers)
+    get_filename_component(source "${header}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    file(RELATIVE_PATH rel ${PROJECT_SOURCE_DIR} ${source})
+    list(APPEND relative ${rel})
+    list(APPEND sources ${source})
+    list(APPEND outputs ${PROJECT_BINARY_DIR}/include/mvflow/${rel})
+  endforeach()
+  add_custom_command(OUTPUT ${outputs}
+    COMMAND ${CMAKE_COMMAND} -DSOURCE_ROOT=${PROJECT_SOURCE_DIR} -DOUTPUT_ROOT=${PROJECT_BINARY_DIR}/include
+            "-DROOTS=${MVFLOW_LAYER_ROOTS}" "-DFILES=${relative}" -P ${MVFLOW_LAYERS_DIR}/prefix_includes.cmake
+    DEPENDS ${sources} ${MVFLOW_LAYERS_DIR}/prefix_includes.cmake
+    COMMENT "Prefixing the includes of ${target}'s headers for installing"
+    VERBATIM)
+  add_custom_target(${target}_headers ALL DEPENDS ${outputs})
+  install(FILES ${outputs} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mvflow/${folder})
 endfunction()
 
 # The layer folders \p target may include: those of the layer targets it links, following

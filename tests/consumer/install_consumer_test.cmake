@@ -1,0 +1,62 @@
+# CTest install_consumer: installs the build into a scratch prefix as README "Installing and using
+# mvflow from CMake" says, checks what was installed, then configures, builds and runs the host
+# project beside this file against that prefix alone.
+#   cmake -DBUILD_DIR=<mvflow build> -DWORK_DIR=<scratch> -DVERSION=<project version>
+#         -DGENERATOR=<generator> -DCXX_COMPILER=<c++> [-DLAUNCHER=<ccache>] -P install_consumer_test.cmake
+cmake_minimum_required(VERSION 3.23)
+set(prefix ${WORK_DIR}/prefix)
+file(REMOVE_RECURSE ${WORK_DIR})
+
+function(run what)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${what} failed (${rc}):\n${out}\n${err}")
+  endif()
+  set(output "${out}" PARENT_SCOPE)
+endfunction()
+
+run("installing" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+
+# The headers are usable with only <prefix>/include on the include path: none includes mvflow
+# root-relative, and neither they nor the package name the build or the source tree.
+file(GLOB_RECURSE headers ${prefix}/include/mvflow/*)
+if(NOT headers)
+  message(FATAL_ERROR "no headers under ${prefix}/include/mvflow")
+endif()
+file(GLOB_RECURSE package_files ${prefix}/lib*/cmake/mvflow/*.cmake)
+get_filename_component(source_dir ${CMAKE_CURRENT_LIST_DIR}/../.. REALPATH)
+foreach(file IN LISTS headers package_files)
+  file(STRINGS ${file} bad REGEX "#[ \t]*include[ \t]*\"(engine|stages|io)/")
+  if(bad)
+    message(FATAL_ERROR "${file} includes mvflow without the mvflow/ prefix: ${bad}")
+  endif()
+  file(READ ${file} text)
+  foreach(tree ${BUILD_DIR} ${source_dir})
+    string(FIND "${text}" "${tree}/" at)
+    if(at GREATER -1)
+      message(FATAL_ERROR "${file} names ${tree}")
+    endif()
+  endforeach()
+endforeach()
+
+run("mvflow --version" ${prefix}/bin/mvflow --version)
+if(NOT output MATCHES "^mvflow ${VERSION}\n")
+  message(FATAL_ERROR "the installed mvflow --version says:\n${output}")
+endif()
+
+set(configure -S ${CMAKE_CURRENT_LIST_DIR} -B ${WORK_DIR}/build -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release
+  -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_PREFIX_PATH=${prefix} -DMVFLOW_EXPECTED_VERSION=${VERSION})
+if(LAUNCHER)
+  list(APPEND configure -DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER})
+endif()
+run("configuring the consumer" ${CMAKE_COMMAND} ${configure})
+file(STRINGS ${WORK_DIR}/build/CMakeCache.txt found REGEX "^mvflow_DIR:")
+if(NOT found MATCHES "=${prefix}/")
+  message(FATAL_ERROR "the consumer found another mvflow: ${found}")
+endif()
+run("building the consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/build)
+run("running the consumer" ${WORK_DIR}/build/mvflow_consumer ${WORK_DIR})
+if(NOT output MATCHES "^mvflow ${VERSION}: [1-9][0-9]* iterations, [1-9][0-9]* vertices read back, closed 1")
+  message(FATAL_ERROR "unexpected consumer output:\n${output}")
+endif()
+message(STATUS "${output}")
