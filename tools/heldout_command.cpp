@@ -11,6 +11,7 @@
 #include "engine/model/error.h"
 #include <tbb/task_arena.h>
 
+#include "engine/model/parallel.h"
 #include "io/atomic_write.h"
 #include "io/image_io.h"
 #include "io/mask_files.h"
@@ -219,7 +220,7 @@ void add_heldout_command(CLI::App& app, Runner& runner) {
       throw CLI::ValidationError("--background", "give one grey value or R,G,B");
     runner = [args](spdlog::logger& log) {
       tbb::task_arena arena(args->threads > 0 ? args->threads : tbb::task_arena::automatic);
-      return arena.execute([&] { return run_heldout(*args, log); });
+      return parallel::execute(arena, [&] { return run_heldout(*args, log); });
     };
   });
 }

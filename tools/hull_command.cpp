@@ -12,6 +12,7 @@
 
 #include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
+#include "engine/model/parallel.h"
 #include "io/atomic_write.h"
 #include "io/image_io.h"
 #include "io/mask_files.h"
@@ -126,7 +127,7 @@ int run_hull(const HullArguments& args, spdlog::logger& log) {
 
   HullMeshResult hull;
   tbb::task_arena arena(args.threads > 0 ? args.threads : tbb::task_arena::automatic);
-  arena.execute([&] { hull = make_hull_mesh(cameras, masks, box, args.options); });
+  parallel::execute(arena, [&] { hull = make_hull_mesh(cameras, masks, box, args.options); });
 
   io::MeshWriteOptions write_options;
   write_options.binary = !args.ascii;

@@ -13,6 +13,7 @@
 #include "engine/model/error.h"
 #include <tbb/task_arena.h>
 
+#include "engine/model/parallel.h"
 #include "io/atomic_write.h"
 #include "io/camera_io.h"
 #include "io/image_io.h"
@@ -362,7 +363,7 @@ int run_synth(SynthArguments& args, spdlog::logger& log) {
   SynthScene scene;
   try {
     tbb::task_arena arena(s.threads > 0 ? s.threads : tbb::task_arena::automatic);
-    arena.execute([&] { scene = make_synth_scene(object.mesh, object.texture, options); });
+    parallel::execute(arena, [&] { scene = make_synth_scene(object.mesh, object.texture, options); });
   } catch (const InputError& e) {
     if (object.mesh_file.empty()) throw;
     throw InputError(object.mesh_file, 0, e.what());  // e.g. an open mesh: name the file

@@ -7,6 +7,7 @@
 #include <chrono>
 
 #include "engine/model/error.h"
+#include "engine/model/parallel.h"
 #include "stages/flow/commit.h"
 #include "stages/flow/curvature.h"
 #include "stages/flow/normals.h"
@@ -117,10 +118,10 @@ void IterationData::photo_speed(std::size_t block) {
       // Idle threads take parts of a long photo node (nested parallelism: the graph is the coarse
       // level). Every vertex is independent, so the parts do not change any result.
       const IndexRange range = blocks[block];
-      oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::uint32_t>(range.begin, range.end, kPhotoGrain),
-                                [&](const oneapi::tbb::blocked_range<std::uint32_t>& part) {
-                                  photo.run(mesh, {part.begin(), part.end()}, views, sample_spacing, fields);
-                                });
+      parallel::parallel_for(oneapi::tbb::blocked_range<std::uint32_t>(range.begin, range.end, kPhotoGrain),
+                             [&](const oneapi::tbb::blocked_range<std::uint32_t>& part) {
+                               photo.run(mesh, {part.begin(), part.end()}, views, sample_spacing, fields);
+                             });
     } else {
       photo.run(mesh, blocks[block], views, sample_spacing, fields);
     }

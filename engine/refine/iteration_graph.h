@@ -14,7 +14,10 @@
 // parallelism). Built once per topology (the block count and ranges are baked into the nodes);
 // run many times.
 
+#include <deque>
+#include <functional>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include <oneapi/tbb/flow_graph.h>
@@ -41,9 +44,17 @@ class IterationGraph {
  private:
   using Node = oneapi::tbb::flow::continue_node<oneapi::tbb::flow::continue_msg>;
   Node* add(std::function<void()> body);
+  //! flow::make_edge(from, to), recorded for ThreadSanitizer (engine/model/parallel.h).
+  void edge(Node& from, Node& to);
 
   oneapi::tbb::flow::graph graph_;  // declared before the nodes: it must outlive them
   std::vector<std::unique_ptr<Node>> nodes_;
+  // Under TSan only: each node's body, whose address stands for the node's completion, and its
+  // predecessors' completions, which happen before it (the edges run inside libtbb.so, which
+  // TSan does not see; engine/model/parallel.h says more).
+  std::deque<std::function<void()>> tsan_bodies_;
+  std::vector<std::vector<const void*>> predecessors_;
+  std::unordered_map<const Node*, std::size_t> index_of_;
   Node* start_ = nullptr;
 };
 

@@ -15,6 +15,7 @@
 #include "engine/refine/iteration.h"
 #include "engine/refine/iteration_graph.h"
 #include "engine/model/mesh_stats.h"
+#include "engine/model/parallel.h"
 #include "stages/topology/adaptive_refinement.h"
 #include "stages/flow/curvature.h"
 #include "stages/flow/image_pyramid.h"
@@ -82,7 +83,7 @@ SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>&
   state.colours.resize(mesh.n_vertices(), Eigen::Vector3f::Zero());
   // Per vertex block in parallel: every vertex's values depend on that vertex alone.
   const std::vector<IndexRange> blocks = split_into_blocks(mesh.n_vertices(), options.block_size);
-  oneapi::tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+  parallel::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
     const IndexRange block = blocks[b];
     compute_normals(mesh, block, fields);
     compute_visibility(mesh, block, views, surface, mean_edge, options.visibility, fields);
@@ -411,7 +412,7 @@ RefineResult refine_mesh(const Scene& scene, const Mesh& initial, const RefineOp
     const int threads = control.threads > 0 ? control.threads : oneapi::tbb::info::default_concurrency();
     // The engine's own arena: the host's default arena and thread count stay untouched.
     oneapi::tbb::task_arena arena(threads);
-    arena.execute([&] {
+    parallel::execute(arena, [&] {
       Refinement refinement(scene, initial, options, control);
       result = refinement.run();
     });

@@ -12,6 +12,7 @@
 #include "engine/model/bounding_box.h"
 #include "engine/model/error.h"
 #include "engine/model/option_check.h"
+#include "engine/model/parallel.h"
 #include "engine/model/surface_query.h"
 
 namespace mvflow {
@@ -46,7 +47,7 @@ DirectedDistances summarize(std::vector<double> distances, double fraction, doub
 
 std::vector<double> distances_to(const std::vector<Eigen::Vector3d>& points, const SurfaceQuery& surface) {
   std::vector<double> distances(points.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024), [&](const auto& range) {
+  parallel::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024), [&](const auto& range) {
     for (std::size_t i = range.begin(); i < range.end(); ++i) distances[i] = surface.closest_point(points[i]).distance;
   });
   return distances;

@@ -11,6 +11,7 @@
 #include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
 #include "engine/model/option_check.h"
+#include "engine/model/parallel.h"
 #include "engine/model/supersample.h"
 
 namespace mvflow {
@@ -206,7 +207,7 @@ HeldoutRendering HeldoutRenderer::render(int view) const {
                         r.unseen[index] || valued == 0 ? options_.background : Eigen::Vector3f(sum / valued));
     }
   };
-  tbb::parallel_for(0, h, render_row);  // in the caller's arena: the result does not depend on it
+  parallel::parallel_for(0, h, render_row);  // in the caller's arena: the result does not depend on it
   return r;
 }
 

@@ -7,6 +7,7 @@
 
 #include "engine/model/error.h"
 #include "engine/model/option_check.h"
+#include "engine/model/parallel.h"
 #include "engine/model/supersample.h"
 #include "engine/model/surface_query.h"
 
@@ -25,7 +26,7 @@ MeshRendering render_mesh(const Mesh& mesh, const Camera& camera, const MeshRend
   MeshRendering result{Image(camera.width(), camera.height()),
                        std::vector<float>(static_cast<std::size_t>(camera.width()) * camera.height(), 0.0f)};
   const int n = options.supersample;
-  tbb::parallel_for(0, camera.height(), [&](int v) {
+  parallel::parallel_for(0, camera.height(), [&](int v) {
     for (int u = 0; u < camera.width(); ++u) {
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       int hits = 0;

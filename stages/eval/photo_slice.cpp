@@ -8,6 +8,7 @@
 #include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
 #include "engine/model/option_check.h"
+#include "engine/model/parallel.h"
 #include "engine/model/surface_query.h"
 #include "stages/flow/normals.h"
 
@@ -75,7 +76,7 @@ PhotoSlice compute_photo_slice(const TriMesh& mesh, const std::vector<PhotoView>
     compute_visibility(mesh, everything, views, surface, edge_lengths(mesh).mean, options.visibility, fields);
   }
 
-  tbb::parallel_for(0, slice.height, [&](int j) {
+  parallel::parallel_for(0, slice.height, [&](int j) {
     for (int i = 0; i < slice.width; ++i) {
       const Eigen::Vector3d X = slice.point(i, j);
       std::span<const std::uint16_t> used(all_views);

@@ -3,6 +3,7 @@
 #include <oneapi/tbb/parallel_for.h>
 
 #include "engine/model/error.h"
+#include "engine/model/parallel.h"
 
 namespace mvflow {
 
@@ -36,7 +37,7 @@ double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vecto
 std::vector<PhotoView> make_photo_views(const Scene& scene) {
   // Decode the images side by side (the store is safe to use from any thread), in the caller's
   // task arena.
-  oneapi::tbb::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t i) { scene.image(i); });
+  parallel::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t i) { scene.image(i); });
   std::vector<PhotoView> views(scene.size());
   for (std::size_t i = 0; i < scene.size(); ++i) {
     const Camera& camera = scene.views[i].camera;

@@ -13,6 +13,7 @@
 #include "engine/model/error.h"
 #include "engine/model/one_ring.h"  // point, is_degenerate
 #include "engine/model/option_check.h"
+#include "engine/model/parallel.h"
 #include "stages/topology/mesh_edit.h"
 
 namespace mvflow {
@@ -110,7 +111,7 @@ std::size_t flip_edges(TriMesh& mesh) {
 //! onto the reference surface. Jacobi: all new positions from the old ones.
 void relax_and_project(TriMesh& mesh, const SurfaceQuery& reference) {
   std::vector<Eigen::Vector3d> moved(mesh.n_vertices());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.n_vertices(), 256), [&](const auto& range) {
+  parallel::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.n_vertices(), 256), [&](const auto& range) {
     for (std::size_t id = range.begin(); id < range.end(); ++id) {
       const VertexHandle v(static_cast<int>(id));
       const Eigen::Vector3d p = point(mesh, v);

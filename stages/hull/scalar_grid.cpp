@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "engine/model/error.h"
+#include "engine/model/parallel.h"
 
 namespace mvflow {
 
@@ -29,7 +30,7 @@ void blur_axis(const ScalarGrid& in, int axis, const std::vector<double>& kernel
   const std::size_t stride = axis == 0 ? 1 : axis == 1 ? static_cast<std::size_t>(in.size[0])
                                                         : static_cast<std::size_t>(in.size[0]) * in.size[1];
   const int lines = in.size[a1] * in.size[a2];
-  tbb::parallel_for(tbb::blocked_range<int>(0, lines, 64), [&](const tbb::blocked_range<int>& range) {
+  parallel::parallel_for(tbb::blocked_range<int>(0, lines, 64), [&](const tbb::blocked_range<int>& range) {
     for (int line = range.begin(); line < range.end(); ++line) {
       int index[3];
       index[axis] = 0;

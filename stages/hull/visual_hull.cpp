@@ -10,6 +10,7 @@
 
 #include "engine/model/error.h"
 #include "engine/model/option_check.h"
+#include "engine/model/parallel.h"
 
 namespace mvflow {
 
@@ -129,8 +130,8 @@ ScalarGrid carve_visual_hull(const std::vector<Camera>& cameras, const std::vect
                        std::to_string(cameras[i].height()));
 
   std::vector<SilhouetteDistance> distances(silhouettes.size());
-  tbb::parallel_for(std::size_t{0}, silhouettes.size(),
-                    [&](std::size_t i) { distances[i] = silhouette_distance(silhouettes[i]); });
+  parallel::parallel_for(std::size_t{0}, silhouettes.size(),
+                         [&](std::size_t i) { distances[i] = silhouette_distance(silhouettes[i]); });
   std::vector<double> focal(cameras.size());
   for (std::size_t i = 0; i < cameras.size(); ++i) focal[i] = cameras[i].focal_pixels();
 
@@ -146,7 +147,7 @@ ScalarGrid carve_visual_hull(const std::vector<Camera>& cameras, const std::vect
   // at the first views that put it far outside.
   const double band = 3.0 * grid.spacing;
   const auto min_views = static_cast<std::size_t>(options.min_views);
-  tbb::parallel_for(tbb::blocked_range<int>(0, grid.size[2]), [&](const tbb::blocked_range<int>& slices) {
+  parallel::parallel_for(tbb::blocked_range<int>(0, grid.size[2]), [&](const tbb::blocked_range<int>& slices) {
     for (int k = slices.begin(); k < slices.end(); ++k)
       for (int j = 0; j < grid.size[1]; ++j)
         for (int i = 0; i < grid.size[0]; ++i) {

@@ -9,6 +9,7 @@
 
 #include "engine/model/error.h"
 #include "engine/model/option_check.h"
+#include "engine/model/parallel.h"
 #include "engine/model/supersample.h"
 
 namespace mvflow {
@@ -151,7 +152,7 @@ Image SynthRenderer::render(const Camera& camera, std::size_t view_index) const 
   MVFLOW_CHECK(camera.width() > 0 && camera.height() > 0, "render: the camera has no image size");
   Image image(camera.width(), camera.height());
   // In the caller's arena (its thread count); the image does not depend on it.
-  tbb::parallel_for(tbb::blocked_range<int>(0, image.height()), [&](const tbb::blocked_range<int>& rows) {
+  parallel::parallel_for(tbb::blocked_range<int>(0, image.height()), [&](const tbb::blocked_range<int>& rows) {
     render_rows(camera, view_index, rows.begin(), rows.end(), image);
   });
   return image;

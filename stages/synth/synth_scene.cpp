@@ -8,6 +8,7 @@
 
 #include "engine/model/error.h"
 #include "engine/model/option_check.h"
+#include "engine/model/parallel.h"
 #include "stages/hull/hull_mesh.h"
 
 namespace mvflow {
@@ -21,7 +22,7 @@ enum SeedStream : std::uint64_t { kSurfaceTexture = 1, kBackgroundTexture = 2, k
 // meets the truth, whatever the background and the texture. Parallel over rows.
 Mask truth_silhouette(const SurfaceQuery& truth, const Camera& camera) {
   Mask mask(camera.width(), camera.height());
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height()), [&](const tbb::blocked_range<int>& rows) {
+  parallel::parallel_for(tbb::blocked_range<int>(0, camera.height()), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y)
       for (int x = 0; x < camera.width(); ++x) {
         const Ray ray = camera.ray(x, y);
