@@ -9,7 +9,8 @@
 # address → build-asan, undefined → build-ubsan, thread → build-tsan, address,undefined →
 # build-asan-ubsan. --targets builds only those targets (and what they need); pass a matching
 # -R to ctest then (tools/check.sh does, for its subset). Suppressions, for the dependencies'
-# own code only, are in tools/sanitizers/.
+# own code only, are in tools/sanitizers/. Under thread, engine/model/parallel.h states to TSan the
+# hand-offs that Debian's uninstrumented oneTBB makes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
