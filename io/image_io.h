@@ -16,9 +16,15 @@ namespace mvflow::io {
 //! too early for a program to set it: so mvflow reads the headers itself.)
 inline constexpr int kMaxImageSide = 32768;
 inline constexpr long long kMaxImagePixels = 1LL << 28;
+//! The most that decoding may allocate: OpenCV's image (3 channels of the file's sample size:
+//! 1 byte, 2 for 16-bit, 4 for float) and, for TIFF, its strip or tile buffer, as the header
+//! states them, refused before decoding. 1 GiB: a 2^28-pixel 8-bit image (768 MiB), 13 000 x
+//! 13 000 16-bit RGB or 9 000 x 9 000 float RGB pixels. mvflow's own float RGB copy (12 bytes a
+//! pixel) comes on top.
+inline constexpr long long kMaxDecodedBytes = 1LL << 30;
 
 //! \throw IoError when the file does not exist; InputError when it is not one of the formats above,
-//!        cannot be decoded or is larger than kMaxImageSide / kMaxImagePixels.
+//!        cannot be decoded or is larger than kMaxImageSide / kMaxImagePixels / kMaxDecodedBytes.
 Image read_image(const std::filesystem::path& file);
 
 struct ImageSize {

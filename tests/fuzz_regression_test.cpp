@@ -279,5 +279,56 @@ TEST(FuzzRegression, TiffWithARepeatedHeightTag) {
   EXPECT_LT(largest_allocation_of([&] { read_image(file); }), 1u << 20);
 }
 
+// Within the pixel limit, a TIFF of 16-bit or float samples with several channels still made
+// OpenCV allocate up to 3 GB (2^28 pixels x 3 channels x 4 bytes) before it found anything wrong:
+// decoding is now refused from the header when its image and buffer would take more than
+// kMaxDecodedBytes (1 GiB). A header-only TIFF stating 16000x16000 RGBA float pixels (256 M, within
+// 2^28) and a PNG header stating 15000x15000 16-bit pixels are refused; the same PNG at 8 bits
+// (675 MB) is not.
+TEST(FuzzRegression, MultiChannelFloatOrSixteenBitImageBeyondTheDecodeLimit) {
+  ScratchFolder folder;
+  const fs::path tiff_file = folder / "photo.tif";
+  std::string tiff("II*\0\x08\0\0\0", 8);
+  const auto put16 = [&](std::uint16_t v) { tiff += static_cast<char>(v & 0xFF), tiff += static_cast<char>(v >> 8); };
+  const auto put32 = [&](std::uint32_t v) { put16(v & 0xFFFF), put16(v >> 16); };
+  const auto entry = [&](std::uint16_t tag, std::uint16_t type, std::uint32_t count, std::uint32_t value) {
+    put16(tag), put16(type), put32(count);
+    type == 3 && count == 1 ? (put16(static_cast<std::uint16_t>(value)), put16(0)) : put32(value);
+  };
+  const std::uint32_t arrays = 8 + 2 + 9 * 12 + 4;  // after the directory: 4 SHORTs each
+  put16(9);
+  entry(256, 4, 1, 16000);      // width
+  entry(257, 4, 1, 16000);      // height
+  entry(258, 3, 4, arrays);     // bits per sample: 32, 32, 32, 32 (at the offset)
+  entry(262, 3, 1, 2);          // RGB
+  entry(273, 4, 1, 200);        // strip offset
+  entry(277, 3, 1, 4);          // samples per pixel: RGBA
+  entry(278, 4, 1, 16);         // rows per strip
+  entry(279, 4, 1, 400000000);  // strip byte count
+  entry(339, 3, 4, arrays + 8);  // sample format: IEEE float (at the offset)
+  put32(0);
+  for (int i = 0; i < 4; ++i) put16(32);
+  for (int i = 0; i < 4; ++i) put16(3);
+  write_text(tiff_file, tiff);
+  for (const std::string& message : image_refusals(tiff_file)) {
+    EXPECT_TRUE(contains(message, tiff_file.string() + ": the image is 16000x16000 pixels of 4-byte samples: "
+                                                       "decoding it takes 2934 MiB; at most 1024 MiB is decoded"))
+        << message;
+  }
+  EXPECT_LT(largest_allocation_of([&] { read_image(tiff_file); }), 1u << 20);
+
+  const fs::path png_file = folder / "photo.png";
+  const auto png = [&](char depth) {
+    return std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x3a\x98\0\0\x3a\x98", 24) + depth + '\x02';
+  };
+  write_text(png_file, png(16));
+  for (const std::string& message : image_refusals(png_file)) {
+    EXPECT_TRUE(contains(message, png_file.string() + ": the image is 15000x15000 pixels of 2-byte samples")) << message;
+  }
+  EXPECT_LT(largest_allocation_of([&] { read_image(png_file); }), 1u << 20);
+  write_text(png_file, png(8));
+  EXPECT_EQ(read_image_size(png_file).width, 15000);
+}
+
 }  // namespace
 }  // namespace mvflow::io
