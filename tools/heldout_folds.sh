@@ -10,6 +10,10 @@
 # OUT/folds.json holds every fold's `mvflow heldout` summaries (per view and pooled) for the hull
 # and the refined mesh, and the means. The hull is `mvflow hull`'s default (no dilation) unless
 # --dilate says otherwise.
+#
+# A PSNR is +inf where the error is zero, and an error with no scored pixel is NaN: `mvflow
+# heldout` prints them as inf and nan and writes null in its JSON, and so does this script for a
+# mean over folds that holds one (inf if any fold's is inf, nan if any is nan).
 set -euo pipefail
 mvflow=${MVFLOW:-$(cd "$(dirname "$0")/.." && pwd)/build/tools/mvflow}  # MVFLOW: another build
 [ -x "$mvflow" ] || { echo "$0: $mvflow is missing: build first (bash tools/build.sh)" >&2; exit 1; }
@@ -78,23 +82,37 @@ for ((f = 0; f < folds; ++f)); do
   } >> "$out/folds.tmp"
 done
 mv "$out/scores.tmp" "$out/scores.txt"
-means=$(awk '{ for (i = 1; i <= 6; ++i) s[i] += $i } END {
-  printf "%.6f %.4f %.6f %.6f %.4f %.6f %.2f", s[1]/NR, s[2]/NR, s[3]/NR, s[4]/NR, s[5]/NR, s[6]/NR,
-         100 * (s[4] - s[1]) / s[1] }' "$out/scores.txt")
-read -r hm hp hs rm rp rs change <<< "$means"
-worse=$(awk '$4 > $1 { n++ } END { print n + 0 }' "$out/scores.txt")
+# The means of the six columns and the MAE change; a column with a value that is no finite number
+# (inf, nan as `mvflow heldout` prints them) has the mean inf or nan, as does a change from them or
+# from a zero MAE. A fold counts as worse only when both MAEs are numbers.
+means=$(awk 'function finite(x) { return x ~ /^[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?$/ }
+  { for (i = 1; i <= 6; ++i) if (finite($i)) s[i] += $i; else if (tolower($i) ~ /nan/) nan[i] = 1; else inf[i] = 1
+    if (finite($1) && finite($4) && $4 > $1) worse++ }
+  END {
+    split("%.6f %.4f %.6f %.6f %.4f %.6f", format, " ")
+    for (i = 1; i <= 6; ++i) printf "%s ", (nan[i] ? "nan" : inf[i] ? "inf" : sprintf(format[i], s[i] / NR))
+    printf "%s %d", (nan[1] || inf[1] || nan[4] || inf[4] || s[1] == 0 ? "nan" : sprintf("%.2f", 100 * (s[4] - s[1]) / s[1])),
+           worse }' "$out/scores.txt")
+read -r hm hp hs rm rp rs change worse <<< "$means"
+# A JSON number, null for inf and nan (JSON has neither).
+json_number() { if [[ $1 =~ ^-?[0-9] ]]; then printf '%s' "$1"; else printf null; fi; }
+# A number with $1 decimals for the text, inf and nan as they are.
+fixed() { if [[ $2 =~ ^-?[0-9] ]]; then printf "%.${1}f" "$2"; else printf '%s' "$2"; fi; }
 # A JSON string: backslashes and quotes escaped.
 json_string() { local text=${1//\\/\\\\}; printf '"%s"' "${text//\"/\\\"}"; }
 {
   printf '{"scene": %s, "folds_count": %d, "hull_dilate": %d, "threshold": %s, "refine_options": %s,\n' \
     "$(json_string "$scene")" "$folds" "$dilate" "$(printf '%g' "$threshold")" "$(json_string "${refine_options[*]}")"
-  printf '"mean": {"hull": {"mae": %s, "psnr_db": %s, "silhouette_disagreement": %s},\n' "$hm" "$hp" "$hs"
-  printf '  "refined": {"mae": %s, "psnr_db": %s, "silhouette_disagreement": %s},\n' "$rm" "$rp" "$rs"
-  printf '  "mae_change_percent": %s, "folds_refined_worse": %s},\n"folds": [\n' "$change" "$worse"
+  printf '"mean": {"hull": {"mae": %s, "psnr_db": %s, "silhouette_disagreement": %s},\n' \
+    "$(json_number "$hm")" "$(json_number "$hp")" "$(json_number "$hs")"
+  printf '  "refined": {"mae": %s, "psnr_db": %s, "silhouette_disagreement": %s},\n' \
+    "$(json_number "$rm")" "$(json_number "$rp")" "$(json_number "$rs")"
+  printf '  "mae_change_percent": %s, "folds_refined_worse": %s},\n"folds": [\n' "$(json_number "$change")" "$worse"
   cat "$out/folds.tmp"
   printf ']}\n'
 } > "$out/folds.json.tmp"
 mv "$out/folds.json.tmp" "$out/folds.json"
 rm -f "$out/folds.tmp"
-printf "mean  %-12s %28s %28s\n" "" "$(printf '%.4f %.2f %.4f' "$hm" "$hp" "$hs")" "$(printf '%.4f %.2f %.4f' "$rm" "$rp" "$rs")"
+printf "mean  %-12s %28s %28s\n" "" "$(fixed 4 "$hm") $(fixed 2 "$hp") $(fixed 4 "$hs")" \
+  "$(fixed 4 "$rm") $(fixed 2 "$rp") $(fixed 4 "$rs")"
 echo "refined vs hull: MAE ${change} %, worse in ${worse} of ${folds} folds (JSON: $out/folds.json)"
