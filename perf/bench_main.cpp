@@ -9,12 +9,12 @@
 
 #include <CLI/CLI.hpp>
 
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <optional>
 
 #include "engine/model/error.h"
+#include "io/atomic_write.h"
 #include "perf/bench_runs.h"
 #include "perf/bench_scene.h"
 #include "perf/bench_table.h"
@@ -142,6 +142,10 @@ int run(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (quick && sizes.empty()) sizes = {"1k/8/640x480", "10k/16/640x480"};
   if (sizes.empty()) sizes = full_grid();
+  // Before the runs, which take minutes to hours: an unwritable output is known at once.
+  if (!json_path.empty()) io::check_writable(json_path);
+  if (!csv_prefix.empty())
+    for (const std::string& suite : suites) io::check_writable(csv_prefix + "_" + suite + ".csv");
 
   nlohmann::ordered_json document;
   document["command"] = [&] {
@@ -169,11 +173,10 @@ int run(int argc, char** argv) {
     document["suites"][suite] = rows;
     if (!csv_prefix.empty()) write_csv(csv_prefix + "_" + suite + ".csv", rows);
   }
-  if (!json_path.empty()) {
-    std::ofstream out(json_path);
-    out << document.dump(2) << "\n";
-    if (!out) throw IoError(json_path, "cannot write the file");
-  }
+  // Through a temporary file renamed into place, as every mvflow output: an interrupted or failed
+  // write leaves the previous JSON whole.
+  if (!json_path.empty())
+    io::write_atomically(json_path, false, [&](std::ostream& out) { out << document.dump(2) << "\n"; });
   return 0;
 }
 

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "engine/model/error.h"
+#include "io/atomic_write.h"
 
 namespace mvflow::perf {
 
@@ -44,21 +45,20 @@ void print_table(std::ostream& out, const std::vector<Row>& rows) {
 }
 
 void write_csv(const std::filesystem::path& path, const std::vector<Row>& rows) {
-  std::ofstream out(path);
-  if (!out) throw IoError(path, "cannot write the file");
-  if (rows.empty()) return;
-  bool first = true;
-  for (const auto& [key, value] : rows.front().items()) out << (first ? "" : ",") << key, first = false;
-  out << '\n';
-  for (const Row& row : rows) {
-    first = true;
-    for (const auto& [key, value] : rows.front().items()) {
-      out << (first ? "" : ",") << format_value(row.value(key, Row()));
-      first = false;
-    }
+  io::write_atomically(path, false, [&](std::ostream& out) {
+    if (rows.empty()) return;
+    bool first = true;
+    for (const auto& [key, value] : rows.front().items()) out << (first ? "" : ",") << key, first = false;
     out << '\n';
-  }
-  if (!out) throw IoError(path, "cannot write the file");
+    for (const Row& row : rows) {
+      first = true;
+      for (const auto& [key, value] : rows.front().items()) {
+        out << (first ? "" : ",") << format_value(row.value(key, Row()));
+        first = false;
+      }
+      out << '\n';
+    }
+  });
 }
 
 double load_average() {

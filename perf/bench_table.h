@@ -15,7 +15,8 @@ using Row = nlohmann::ordered_json;  //!< column name → number or string, in c
 
 //! The rows as a text table (columns of the first row; numbers as given by format_value).
 void print_table(std::ostream& out, const std::vector<Row>& rows);
-//! The rows as CSV with a header line. \throw IoError when the file cannot be written.
+//! The rows as CSV with a header line, through a temporary file renamed into place (io/atomic_write.h).
+//! \throw IoError when the file cannot be written; the old file is then untouched.
 void write_csv(const std::filesystem::path& path, const std::vector<Row>& rows);
 //! A value for the text table and CSV: integers as they are, other numbers with 4 significant
 //! digits.
