@@ -388,7 +388,7 @@ class Refinement {
   std::vector<Eigen::Vector3d> reference_;
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
   std::optional<SilhouetteConstraint> inside_;
-  std::vector<Mask> rim_masks_;  //!< one per view of full_views_ with options.rims.enabled
+  std::vector<Mask> rim_masks_;  //!< one per view of full_views_ when the rims are fitted (fits_rims)
 };
 
 }  // namespace
