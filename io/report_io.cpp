@@ -1,5 +1,7 @@
 #include "io/report_io.h"
 
+#include <cmath>
+
 #include "io/atomic_write.h"
 
 namespace mvflow::io {
@@ -22,6 +24,7 @@ nlohmann::json iteration_json(const IterationReport& r) {
           {"max_speed", r.max_speed},
           {"time_step", r.time_step},
           {"median_move_over_cfl_edge", r.median_move},
+          {"net_normal_move_over_edge", std::isfinite(r.net_move) ? nlohmann::json(r.net_move) : nlohmann::json(nullptr)},
           {"stop", r.stop},
           {"seconds", r.seconds},
           {"stage_seconds", stages}};

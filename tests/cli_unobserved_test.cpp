@@ -44,9 +44,14 @@ TEST(CliUnobserved, AGrazingCapFollowsTheObservedSurface) {
                                       "--init offset:0.011547 --init-vertices 2562 --elevation -15,25 -o " +
                                       scene.string());
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  const auto off = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "off.ply").string());
+  // Without the step damping (default on), as when the spread was measured: with it the observed
+  // region improves more than the cap (0.0010 against 0.0026 with the spread), so the ratio is
+  // 2.6; Quality.TwoRingSphereSettlesWithinSixtyIterations holds the damped run to issue 12's
+  // absolute targets instead.
+  const auto off = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "off.ply").string() +
+                                    " --damping off");
   const auto on = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "on.ply").string() +
-                                   " --spread-unobserved on");
+                                   " --spread-unobserved on --damping off");
   ASSERT_EQ(off.exit_code, 0) << off.output;
   ASSERT_EQ(on.exit_code, 0) << on.output;
   EXPECT_NE(on.output.find("unobserved vertices with the observed surface"), std::string::npos) << on.output;

@@ -61,7 +61,7 @@ void expect_refinement_halves_the_error(const std::string& name, const std::stri
   EXPECT_EQ(r.at("final").at("self_intersecting_face_pairs").get<int>(), 0);
   // It ended by a stopping rule, well inside the iteration budget (issue 12: convergence).
   const std::string status = r.at("status").get<std::string>();
-  EXPECT_TRUE(status == "converged" || status == "step-small") << status;
+  EXPECT_TRUE(status == "converged" || status == "step-small" || status == "settled") << status;
   EXPECT_LE(r.at("iterations").size(), 0.75 * r.at("options").at("max_iterations").get<double>());
 
   const test::CommandResult info = test::run_mvflow("info " + scene.string() + " --mesh " + refined.string());
@@ -87,6 +87,42 @@ TEST(Quality, Bunny) {
   // flow on the bunny (render seeds 1–6: 0–7 pairs of ~9 500 faces); the refined mesh must now
   // have none, like the other scenes.
   expect_refinement_halves_the_error("bunny", "--preset bunny" + kSmall);
+}
+
+// Issue 12's targets on its sphere rig (24 views on rings at −15° and +25°, so the cap below
+// −55° is seen only at grazing angles; the initial mesh 1 % of the diagonal outside), with the
+// option for rigs that leave a region unseen (--spread-unobserved on): mean ≤ 0.0025, acc90
+// ≤ 0.005, completeness 100 %, and the run ends by a stopping rule in ≤ 60 iterations
+// (measured: 41 iterations, settled, 0.00096 / 0.00223). Without the spread the unseen cap
+// drifts outward under the smoothing (README, "Quality": completeness 99.6 %).
+TEST(Quality, TwoRingSphereSettlesWithinSixtyIterations) {
+  const test::ScratchFolder dir;
+  const auto scene = dir.path() / "scene";
+  const test::CommandResult synth = test::run_mvflow(
+      "synth --amplitude 0 --views 24 --width 640 --height 480 --level 6 --init offset:0.011547 "
+      "--init-vertices 2562 --elevation -15,25 -o " + scene.string());
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const auto refined = dir.path() / "refined.ply";
+  const auto report = dir.path() / "report.json";
+  const test::CommandResult refine =
+      test::run_mvflow("refine " + scene.string() + " -o " + refined.string() + " --report " + report.string() +
+                       " --spread-unobserved on");
+  ASSERT_EQ(refine.exit_code, 0) << refine.output;
+  const auto eval_json = dir.path() / "eval.json";
+  const test::CommandResult eval = test::run_mvflow("eval " + refined.string() + " " + (scene / "truth.ply").string() +
+                                                    " --samples 50000 --json " + eval_json.string());
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  const nlohmann::json e = nlohmann::json::parse(test::read_text(eval_json));
+  const nlohmann::json r = nlohmann::json::parse(test::read_text(report));
+  const std::string status = r.at("status").get<std::string>();
+  std::printf("[measured] two-ring sphere: mean %.5g, acc90 %.5g, completeness %.4g, %zu iterations (%s)\n",
+              e.at("symmetric_mean").get<double>(), e.at("accuracy").get<double>(),
+              e.at("completeness").get<double>(), r.at("iterations").size(), status.c_str());
+  EXPECT_LE(e.at("symmetric_mean").get<double>(), 0.0025);
+  EXPECT_LE(e.at("accuracy").get<double>(), 0.005);
+  EXPECT_EQ(e.at("completeness").get<double>(), 1.0);
+  EXPECT_TRUE(status == "converged" || status == "settled") << status;
+  EXPECT_LE(r.at("iterations").size(), 60u);
 }
 
 }  // namespace

@@ -17,7 +17,8 @@ constexpr double large_move = 1.0;  // far above τ: only the Σg rule or the bu
 // The thesis's test (every one of the last five changes below ε) with the thesis preset's budget
 // and SPEC §4's step tolerance.
 StoppingOptions each_lookback() {
-  return StoppingOptions{.test = ConvergenceTest::EachLookback, .max_iterations = 100, .median_move_tolerance = 0.002};
+  return StoppingOptions{.epsilon_percent = 0.3, .test = ConvergenceTest::EachLookback, .max_iterations = 100,
+                         .median_move_tolerance = 0.002, .settled_tolerance = 0.0};
 }
 
 // Feeds \p g and returns the iteration (1-based) at which the criterion stopped, 0 if never.
@@ -32,21 +33,25 @@ std::pair<std::size_t, StopReason> run(const std::vector<double>& g, double move
   return {0, StopReason::Continue};
 }
 
-TEST(StoppingOptions, DefaultsFollowTheThesisButForTheTestTheBudgetAndTheStepTolerance) {
+TEST(StoppingOptions, DefaultsFollowTheThesisButForTheTestTheBudgetAndTheMoveRules) {
   const StoppingOptions o;
   EXPECT_NO_THROW(o.check());
   EXPECT_EQ(o.test, ConvergenceTest::NoImprovement);
   EXPECT_EQ(o.epsilon_percent, 0.3);
+  EXPECT_EQ(o.settled_tolerance, 0.0025);
   EXPECT_EQ(o.min_iterations, 10);
   EXPECT_EQ(o.max_iterations, 200);
   EXPECT_EQ(o.lookback, 5);
-  EXPECT_EQ(o.median_move_tolerance, 0.001);
+  EXPECT_EQ(o.median_move_tolerance, 0.0);
+  EXPECT_THROW((StoppingOptions{.settled_tolerance = -1.0}).check(), OptionError);
+  EXPECT_THROW((StoppingOptions{.settled_tolerance = INFINITY}).check(), OptionError);
   EXPECT_THROW((StoppingOptions{.epsilon_percent = 0.0}).check(), OptionError);
   EXPECT_THROW((StoppingOptions{.min_iterations = 5}).check(), OptionError);  // needs lookback + 1
   EXPECT_THROW((StoppingOptions{.max_iterations = 9}).check(), OptionError);
   EXPECT_THROW(StoppingCriterion(StoppingOptions{.lookback = 0}), Error);
   EXPECT_STREQ(to_string(StopReason::Converged), "converged");
   EXPECT_STREQ(to_string(StopReason::StepSmall), "step-small");
+  EXPECT_STREQ(to_string(StopReason::Settled), "settled");
   EXPECT_STREQ(to_string(StopReason::MaxIterations), "max-iterations");
   EXPECT_STREQ(to_string(StopReason::Continue), "continue");
 }
@@ -106,6 +111,30 @@ TEST(Stopping, WhenTheMedianMoveIsSmallFromMinIterationsOn) {
   EXPECT_EQ(run(std::vector<double>(30, 5.0), 0.0), std::make_pair(std::size_t{10}, StopReason::Converged));
 }
 
+// Feeds Σg falling 1 % per iteration (never converged) with the net moves \p net, from iteration 1.
+std::pair<std::size_t, StopReason> run_net(const std::vector<double>& net, StoppingOptions options = {}) {
+  StoppingCriterion criterion(options);
+  for (std::size_t i = 0; i < net.size(); ++i) {
+    const StopReason reason = criterion.add_iteration(1000.0 * std::pow(0.99, static_cast<double>(i)), large_move, 0, net[i]);
+    if (reason != StopReason::Continue) return {i + 1, reason};
+  }
+  return {0, StopReason::Continue};
+}
+
+TEST(Stopping, SettledWhenTheNetMoveFallsBelowTauFromMinIterationsOn) {
+  // NaN for the first five iterations (no window yet), then the net move halves every iteration
+  // from 0.1: below τ = 0.0025 from iteration 12 (0.1/2^6 = 0.0016; 0.0031 at 11).
+  std::vector<double> net(5, std::nan(""));
+  for (int i = 6; i <= 40; ++i) net.push_back(0.1 * std::pow(0.5, i - 6));
+  EXPECT_EQ(run_net(net), std::make_pair(std::size_t{12}, StopReason::Settled));
+  // Below τ from the start: not before min_iterations.
+  EXPECT_EQ(run_net(std::vector<double>(40, 0.0)), std::make_pair(std::size_t{10}, StopReason::Settled));
+  // Never on NaN, never when disabled, never at or above τ.
+  EXPECT_EQ(run_net(std::vector<double>(40, std::nan(""))).second, StopReason::Continue);
+  EXPECT_EQ(run_net(net, StoppingOptions{.settled_tolerance = 0.0}).second, StopReason::Continue);
+  EXPECT_EQ(run_net(std::vector<double>(40, 0.0025)).second, StopReason::Continue);
+}
+
 TEST(Stopping, NoImprovementStopsAnAlternationThatEachLookbackNeverStops) {
   // Σg falls 2 % per iteration to iteration 20, then alternates ±5 % around its last level, as
   // it does once the fastest vertices step across the minimum of g and back.
@@ -122,12 +151,16 @@ TEST(Stopping, NoImprovementWaitsForEpsilonAndRestartsWithTheResolution) {
   // 1 % lower every iteration: always an improvement beyond 0.3 % over five iterations.
   std::vector<double> g;
   for (int i = 1; i <= 60; ++i) g.push_back(1000.0 * std::pow(0.99, i));
-  EXPECT_EQ(run(g, large_move, StoppingOptions{}), std::make_pair(std::size_t{0}, StopReason::Continue));
+  EXPECT_EQ(run(g, large_move, StoppingOptions{.epsilon_percent = 0.1}),
+            std::make_pair(std::size_t{0}, StopReason::Continue));
   // 0.05 % per iteration: the best of the last five is 0.25 % below the best before: converged
-  // as soon as the history is long enough (min_iterations = 10).
+  // as soon as the history is long enough (min_iterations = 10) with ε = 0.3 %, never with 0.1 %.
   g.clear();
   for (int i = 1; i <= 40; ++i) g.push_back(1000.0 * std::pow(0.9995, i));
-  EXPECT_EQ(run(g, large_move, StoppingOptions{}), std::make_pair(std::size_t{10}, StopReason::Converged));
+  EXPECT_EQ(run(g, large_move, StoppingOptions{.epsilon_percent = 0.3}),
+            std::make_pair(std::size_t{10}, StopReason::Converged));
+  EXPECT_EQ(run(g, large_move, StoppingOptions{.epsilon_percent = 0.1}),
+            std::make_pair(std::size_t{0}, StopReason::Continue));
   // After restart() the rules wait min_iterations again, but the budget counts on.
   StoppingCriterion criterion{StoppingOptions{.max_iterations = 25}};
   for (int i = 1; i <= 10; ++i) criterion.add_iteration(5.0, large_move);

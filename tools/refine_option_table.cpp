@@ -209,8 +209,13 @@ std::vector<RefineOptionEntry> make_table() {
                     [](auto& o) -> auto& { return o.stopping.min_iterations; }));
   t.push_back(value("--max-iterations", "max_iterations", "stopping.max_iterations", "Stop after this many iterations (over all resolutions)",
                     [](auto& o) -> auto& { return o.stopping.max_iterations; }));
-  t.push_back(value("--step-tolerance", "median_move_tolerance", "stopping.median_move_tolerance", "Stop when the median move is below this × e_min",
+  t.push_back(value("--step-tolerance", "median_move_tolerance", "stopping.median_move_tolerance",
+                    "Stop when the median move of one iteration is below this × e_min (0 = off; thesis preset: 0.002)",
                     [](auto& o) -> auto& { return o.stopping.median_move_tolerance; }));
+  t.push_back(value("--settle-tolerance", "settled_tolerance", "stopping.settled_tolerance",
+                    "Stop (settled) when the median net move along the normal over the last 5 iterations is below "
+                    "this × the vertex's shortest edge (0 = off, the thesis preset)",
+                    [](auto& o) -> auto& { return o.stopping.settled_tolerance; }));
   t.push_back(switch_flag("--no-remeshing", "global_remeshing", "Skip the global split/collapse before the flow",
                           [](auto& o) -> auto& { return o.global_remeshing; }, false));
   t.push_back(value("--refine-min-pixels", "adaptive_min_edge_pixels", "adaptive.min_edge_pixels",
@@ -245,6 +250,10 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(on_off("--step-control", "step_control",
                      "Halve the steps after an iteration that raised Σg/vertex, grow them back after one that lowered it",
                      [](auto& o) -> auto& { return o.step_control; }));
+  t.push_back(on_off("--damping", "step_damping",
+                     "Per-vertex step damping: halve a vertex's step when its speed along the normal reverses, "
+                     "grow it back toward the CFL step while it does not (thesis preset: off)",
+                     [](auto& o) -> auto& { return o.damping.enabled; }));
   t.push_back(switch_flag("--keep-inside-silhouettes", "keep_inside_silhouettes",
                           "Keep the surface inside the visual hull of the used views' silhouettes (photographs on a "
                           "dark background)",

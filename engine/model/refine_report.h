@@ -37,6 +37,9 @@ struct IterationReport {
   //! median over the moving vertices of their move divided by the edge the CFL bound used for them
   //! (their own shortest edge with the local bound, e_min with the global one)
   double median_move = 0.0;
+  //! median over the moving vertices of their net move along the normal over the stopping rule's
+  //! lookback, divided by their shortest edge (NetNormalMove); NaN in the first iterations of a topology
+  double net_move = 0.0;
   std::string stop;                   //!< "continue", or why the refinement stops after it
   double seconds = 0.0;               //!< wall time of the whole iteration
   std::array<double, kStageCount> stage_seconds{};
@@ -44,7 +47,7 @@ struct IterationReport {
   double sum_g_per_vertex() const { return defined_g ? sum_g / static_cast<double>(defined_g) : 0.0; }
 };
 
-enum class RefineStatus { Converged, StepSmall, MaxIterations, Cancelled, Failed };
+enum class RefineStatus { Converged, StepSmall, Settled, MaxIterations, Cancelled, Failed };
 const char* to_string(RefineStatus status);
 
 struct RefineSummary {
@@ -66,6 +69,7 @@ inline const char* to_string(RefineStatus status) {
   switch (status) {
     case RefineStatus::Converged: return "converged";
     case RefineStatus::StepSmall: return "step-small";
+    case RefineStatus::Settled: return "settled";
     case RefineStatus::MaxIterations: return "max-iterations";
     case RefineStatus::Cancelled: return "cancelled";
     case RefineStatus::Failed: return "failed";

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "engine/model/error.h"
 #include "engine/model/parallel.h"
@@ -56,7 +57,12 @@ void run_block(IterationData& data, std::size_t block, double* seconds, Body&& b
 
 IterationData::IterationData(TriMesh& mesh_, const std::vector<PhotoView>& views_, const RefineOptions& options_,
                              const std::atomic<bool>* cancel_)
-    : mesh(mesh_), views(views_), options(options_), cancel(cancel_), photo(options_.photo) {}
+    : mesh(mesh_),
+      views(views_),
+      options(options_),
+      cancel(cancel_),
+      photo(options_.photo),
+      net_move(options_.stopping.lookback) {}
 
 void IterationData::reset_topology() {
   surface = std::make_unique<SurfaceQuery>(mesh);
@@ -72,6 +78,9 @@ void IterationData::reset_topology() {
   last_time_step = 0.0;
   step_scale = 1.0;  // Σg/vertex of another mesh says nothing about the steps on this one
   previous_g_per_vertex = 0.0;
+  damping.reset(mesh.n_vertices());
+  net_move.reset();
+  net_move_over_edge = std::numeric_limits<double>::quiet_NaN();
 }
 
 void IterationData::set_edge_lengths(const EdgeLengths& edges) {
@@ -183,6 +192,7 @@ void IterationData::measure_moves() {
     relative.push_back(edge > 0 ? moved[id] / edge : 0.0);
   }
   median_move = median_of(relative);
+  net_move_over_edge = net_move.record(mesh, fields);
 }
 
 void IterationData::adapt_step_scale() {
@@ -197,7 +207,10 @@ void IterationData::adapt_step_scale() {
 
 void IterationData::move(std::size_t block) {
   run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Move)],
-            [&] { move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside, &moved); });
+            [&] {
+              if (options.damping.enabled) damp_speeds(blocks[block], options.damping, fields, damping);
+              move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside, &moved);
+            });
 }
 
 void IterationData::smooth(std::size_t block) {

@@ -19,11 +19,13 @@
 #include "engine/model/refine_report.h"
 #include "engine/model/surface_query.h"
 #include "engine/model/vertex_fields.h"
+#include "stages/flow/net_move.h"
 #include "stages/flow/photo_gradient.h"
 #include "stages/flow/photo_views.h"
 #include "stages/flow/silhouette_constraint.h"
 #include "stages/flow/silhouette.h"
 #include "stages/flow/speed.h"
+#include "stages/flow/step_damping.h"
 
 namespace mvflow {
 
@@ -69,9 +71,14 @@ struct IterationData {
   MoveLimit move_limit;      //!< the CFL bound on one vertex's move
   double step_scale = 1.0;   //!< the fraction of the CFL step taken (step control), reset with the topology
   double previous_g_per_vertex = 0.0;  //!< Σg/vertex of the previous iteration on this topology
+  StepDampingState damping;  //!< per-vertex step scales (options.damping), reset with the topology
+  NetNormalMove net_move;    //!< positions of the last iterations of this topology, for the settled rule
   //! Set by measure_moves(): the median over the moving vertices of their move divided by the
   //! edge the CFL bound used for them (their own shortest edge, or e_min with the global bound).
   double median_move = 0.0;
+  //! Set by measure_moves(): NetNormalMove::record over options.stopping.lookback iterations (NaN
+  //! until that many ran on this topology).
+  double net_move_over_edge = 0.0;
   std::size_t moving = 0;
   double serial_seconds[kStageCount] = {};
 
@@ -98,7 +105,7 @@ struct IterationData {
   void cfl();                          //!< serial: combine partials in block order, Δt, median move
   void adapt_step_scale();             //!< part of cfl(): the step control
   void fill_speeds();                  //!< part of cfl(): speeds of unobserved vertices
-  void move(std::size_t block);        //!< P ← P + Δt·F
+  void move(std::size_t block);        //!< the steps damped (options.damping), then P ← P + Δt·F
   void measure_moves();                //!< serial, after the iteration: median_move
   void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
   void inflate(std::size_t block);     //!< new position of Taubin's second step (taubin_pass_band > 0)

@@ -16,6 +16,7 @@ void RefineOptions::check() const {
   check_member(speed, "speed");
   require_option(cfl > 0 && cfl <= 10, "cfl", cfl, "(0, 10]");
   require_option(speed_quantile > 0 && speed_quantile <= 1, "speed_quantile", speed_quantile, "(0, 1]");
+  check_member(damping, "damping");
   check_member(smoothing, "smoothing");
   check_member(regularization, "regularization");
   check_member(stopping, "stopping");
@@ -41,6 +42,8 @@ RefineOptions thesis_preset() {
   options.stopping.epsilon_percent = 0.3;
   options.stopping.max_iterations = 100;
   options.stopping.median_move_tolerance = 0.002;
+  options.stopping.settled_tolerance = 0.0;
+  options.damping.enabled = false;
   options.speed_quantile = 1.0;
   options.local_step = false;
   options.step_control = false;

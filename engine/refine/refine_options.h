@@ -15,6 +15,7 @@
 #include "stages/flow/silhouette_rims.h"
 #include "stages/flow/smoothing.h"
 #include "stages/flow/speed.h"
+#include "stages/flow/step_damping.h"
 #include "stages/flow/stopping.h"
 #include "stages/flow/unobserved_displacement.h"
 #include "stages/flow/unobserved_speed.h"
@@ -63,6 +64,8 @@ struct RefineOptions {
   //! mesh), the last step overshot, so the steps are halved; after a decrease they grow back by
   //! 1.25× up to the CFL step. false: always the CFL step (the thesis).
   bool step_control = false;
+  //! Per-vertex step damping (stages/flow/step_damping.h): on by default; off in the thesis preset.
+  StepDampingOptions damping;
   SmoothingOptions smoothing;
   RegularizationOptions regularization;
   StoppingOptions stopping;

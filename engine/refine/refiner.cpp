@@ -117,6 +117,7 @@ RefineStatus status_of(StopReason reason) {
   switch (reason) {
     case StopReason::Converged: return RefineStatus::Converged;
     case StopReason::StepSmall: return RefineStatus::StepSmall;
+    case StopReason::Settled: return RefineStatus::Settled;
     default: return RefineStatus::MaxIterations;
   }
 }
@@ -188,7 +189,8 @@ class Refinement {
         break;
       }
       fill_report(report, edges, refinement_seconds, iteration_start);
-      StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move, data_.total.defined_g);
+      StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move, data_.total.defined_g,
+                                                   data_.net_move_over_edge);
       report.stop = to_string(reason);
       const bool budget_left = stopping.iterations() < static_cast<std::size_t>(options_.stopping.max_iterations);
       if (budget_left && refine_at_convergence(reason, report)) {
@@ -315,12 +317,14 @@ class Refinement {
   // (with either refinement schedule); at full resolution, refine; true when that changed the
   // images or the mesh (the run goes on), recorded in \p report.
   bool refine_at_convergence(StopReason reason, IterationReport& report) {
-    if (reason != StopReason::Converged && reason != StopReason::StepSmall) return false;
+    if (reason != StopReason::Converged && reason != StopReason::StepSmall && reason != StopReason::Settled)
+      return false;
     if (!levels_.empty()) {  // settled on these images: the next finer ones before any refinement
       levels_.pop_back();
       views_ = levels_.empty() ? full_views_ : levels_.back()->views;
       data_.step_scale = 1.0;  // Σg/vertex on other images says nothing about the steps on these
       data_.previous_g_per_vertex = 0.0;
+      data_.damping.reset(mesh_.n_vertices());  // reversals on other images say nothing about these
       report.stop = std::string("finer images (") + to_string(reason) + ")";
       if (control_.logger) control_.logger->info("images at 1/{} of their resolution from here", 1 << levels_.size());
       return true;
@@ -351,6 +355,7 @@ class Refinement {
     report.max_speed = data_.total.max_speed;
     report.time_step = data_.time_step;
     report.median_move = data_.median_move;
+    report.net_move = data_.net_move_over_edge;
     for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] = data_.serial_seconds[s];
     for (const auto& slots : data_.block_seconds)  // block order: the same sum every run
       for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] += slots[s];

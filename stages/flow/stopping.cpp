@@ -17,6 +17,8 @@ const char* to_string(StopReason reason) {
       return "converged";
     case StopReason::StepSmall:
       return "step-small";
+    case StopReason::Settled:
+      return "settled";
     case StopReason::MaxIterations:
       return "max-iterations";
   }
@@ -32,6 +34,8 @@ void StoppingOptions::check() const {
                  ">= min_iterations (" + std::to_string(min_iterations) + ")");
   require_option(median_move_tolerance >= 0.0 && std::isfinite(median_move_tolerance), "median_move_tolerance",
                  median_move_tolerance, ">= 0 and finite");
+  require_option(settled_tolerance >= 0.0 && std::isfinite(settled_tolerance), "settled_tolerance", settled_tolerance,
+                 ">= 0 and finite");
 }
 
 StoppingCriterion::StoppingCriterion(StoppingOptions options) : options_(options) {
@@ -86,12 +90,14 @@ std::vector<double> StoppingCriterion::last_changes_percent() const {
   return changes;
 }
 
-StopReason StoppingCriterion::add_iteration(double sum_g, double median_move_over_emin, std::size_t vertices_with_g) {
+StopReason StoppingCriterion::add_iteration(double sum_g, double median_move_over_emin, std::size_t vertices_with_g,
+                                            double net_move_over_edge) {
   history_.push_back(sum_g);
   history_per_vertex_.push_back(vertices_with_g > 0 ? sum_g / static_cast<double>(vertices_with_g) : sum_g);
   if (history_.size() >= static_cast<std::size_t>(options_.min_iterations)) {
     if (converged()) return StopReason::Converged;
     if (median_move_over_emin < options_.median_move_tolerance) return StopReason::StepSmall;
+    if (net_move_over_edge < options_.settled_tolerance) return StopReason::Settled;  // false for NaN
   }
   if (iterations() >= static_cast<std::size_t>(options_.max_iterations)) return StopReason::MaxIterations;
   return StopReason::Continue;

@@ -1,0 +1,46 @@
+#include "stages/flow/net_move.h"
+
+#include <cmath>
+#include <limits>
+
+#include "engine/model/error.h"
+#include "stages/flow/speed.h"
+
+namespace mvflow {
+
+NetNormalMove::NetNormalMove(int window) : window_(window) {
+  MVFLOW_CHECK(window >= 1, "NetNormalMove: the window must be >= 1");
+  ring_.resize(static_cast<std::size_t>(window) + 1);
+}
+
+void NetNormalMove::reset() {
+  next_ = 0;
+  recorded_ = 0;
+}
+
+double NetNormalMove::record(const TriMesh& mesh, const VertexFields& fields) {
+  const std::size_t n = mesh.n_vertices();
+  MVFLOW_CHECK(fields.size() == n, "NetNormalMove: fields are not sized for the mesh");
+  MVFLOW_CHECK(recorded_ == 0 || ring_[(next_ + ring_.size() - 1) % ring_.size()].size() == n,
+               "NetNormalMove: the vertex count changed without a reset");
+  std::vector<Eigen::Vector3d>& now = ring_[next_];
+  now.resize(n);
+  for (std::size_t v = 0; v < n; ++v) now[v] = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+  next_ = (next_ + 1) % ring_.size();
+  ++recorded_;
+  if (recorded_ < ring_.size()) return std::numeric_limits<double>::quiet_NaN();
+
+  const std::vector<Eigen::Vector3d>& before = ring_[next_];  // the oldest: window iterations ago
+  std::vector<double> relative;
+  relative.reserve(n);
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (!(fields.defined[v] & kSpeedDefined) || mesh.is_boundary(TriMesh::VertexHandle(static_cast<int>(v)))) continue;
+    const double edge = fields.local_edge[v];
+    if (!(edge > 0.0) || !std::isfinite(edge)) continue;
+    relative.push_back(std::abs((now[v] - before[v]).dot(fields.normal[v])) / edge);
+  }
+  if (relative.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return median_of(std::move(relative));
+}
+
+}  // namespace mvflow

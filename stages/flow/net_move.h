@@ -1,0 +1,47 @@
+#pragma once
+// How far the surface has really moved over the last few iterations: the net move of each vertex
+// along its normal over a window of iterations, not the sum of its steps. The settled stopping
+// rule reads it (StoppingOptions::settled_tolerance).
+//
+// Why: at the finest level Σg/vertex keeps falling by about 1 % an iteration long after the
+// error to the true surface has stopped changing (vertices sliding tangentially, noise in g
+// averaged away), and a vertex that jitters across the minimum of g makes large steps with no
+// net move. Neither is progress; a net move along the normal is.
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/model/mesh.h"
+#include "engine/model/vertex_fields.h"
+
+namespace mvflow {
+
+//! The positions of the last window + 1 iterations of one topology, and their net move.
+class NetNormalMove {
+ public:
+  //! \param window The number of iterations the move is taken over; ≥ 1.
+  explicit NetNormalMove(int window);
+
+  //! Forgets the positions (a new topology: vertex ids no longer match).
+  void reset();
+
+  //! Records the mesh's current positions (after an iteration) and returns the median, over the
+  //! vertices with kSpeedDefined that are not on a boundary, of |(P_now − P_window ago)·N| divided
+  //! by the vertex's shortest edge (fields.local_edge), N = fields.normal. NaN until window + 1
+  //! positions of this topology are recorded, or when no vertex counts.
+  //! \throw Error if the fields are not sized for the mesh or the vertex count changed since the
+  //!        last record without a reset.
+  double record(const TriMesh& mesh, const VertexFields& fields);
+
+  int window() const { return window_; }
+
+ private:
+  int window_;
+  std::vector<std::vector<Eigen::Vector3d>> ring_;  // window + 1 slots, the oldest at next_
+  std::size_t next_ = 0;                             // the slot the next record overwrites
+  std::size_t recorded_ = 0;                         // positions recorded since the reset
+};
+
+}  // namespace mvflow

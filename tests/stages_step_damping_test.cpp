@@ -1,0 +1,189 @@
+// Per-vertex step damping and the net move along the normal (issue 12: convergence that tells
+// drift from progress): hand-made speeds, an analytic stiff case, and spheres moved by known
+// amounts.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "engine/model/error.h"
+#include "engine/model/option_check.h"
+#include "stages/flow/net_move.h"
+#include "stages/flow/speed.h"  // compute_local_edges, median_of
+#include "stages/flow/step_damping.h"
+#include "stages_meshes.h"
+
+namespace mvflow {
+namespace {
+
+using test::all_vertices;
+using test::icosphere;
+
+// One vertex at height x on the z axis whose speed is the photo term alone, F = −(∇g·N)N with
+// ∇g = k·x·N (N = +z, g = 0): the flow of the energy k·x²/2, whose forward Euler step
+// x ← (1 − dt·k)·x diverges for dt·k > 2.
+struct StiffVertex {
+  VertexFields fields;
+  double x = 1.0;
+  explicit StiffVertex() { fields.resize(1, 0); fields.normal[0] = Eigen::Vector3d::UnitZ(); }
+  void set_speed(double k) {
+    fields.photo_gradient[0] = k * x * fields.normal[0];
+    fields.speed[0] = -fields.photo_gradient[0].dot(fields.normal[0]) * fields.normal[0];
+    fields.defined[0] = kSpeedDefined;
+  }
+};
+
+TEST(StepDamping, OptionsAreChecked) {
+  EXPECT_NO_THROW(StepDampingOptions{}.check());
+  EXPECT_THROW((StepDampingOptions{.shrink = 1.0}).check(), OptionError);
+  EXPECT_THROW((StepDampingOptions{.shrink = 0.0}).check(), OptionError);
+  EXPECT_THROW((StepDampingOptions{.grow = 0.9}).check(), OptionError);
+  EXPECT_THROW((StepDampingOptions{.min_scale = 0.0}).check(), OptionError);
+  EXPECT_THROW((StepDampingOptions{.min_scale = 1.5}).check(), OptionError);
+}
+
+TEST(StepDamping, AReversalHalvesTheScaleAndAKeptDirectionGrowsItBackToOne) {
+  VertexFields fields;
+  fields.resize(3, 0);
+  for (int v = 0; v < 3; ++v) {
+    fields.normal[v] = Eigen::Vector3d::UnitX();
+    fields.defined[v] = kSpeedDefined;
+  }
+  StepDampingState state;
+  state.reset(3);
+  const StepDampingOptions options;
+  // Vertex 0 alternates, vertex 1 keeps its direction, vertex 2 loses its speed at step 3.
+  const double expected_alternating[] = {1.0, 0.5, 0.25, 0.125, 0.125, 0.125};
+  for (int step = 0; step < 6; ++step) {
+    fields.speed[0] = (step % 2 ? -1.0 : 1.0) * Eigen::Vector3d::UnitX();
+    fields.speed[1] = 2.0 * Eigen::Vector3d::UnitX();
+    fields.speed[2] = (step % 2 ? -1.0 : 1.0) * Eigen::Vector3d::UnitX();
+    fields.defined[2] = step == 3 ? 0 : kSpeedDefined;
+    damp_speeds({0, 3}, options, fields, state);
+    EXPECT_EQ(state.scale[0], expected_alternating[step]) << step;
+    EXPECT_EQ(state.scale[1], 1.0) << step;  // never above the CFL step
+  }
+  // Vertex 2 reversed at steps 1 and 2 (0.25), had no speed at 3 (kept 0.25, forgot its
+  // direction), so step 4 is no reversal and step 5 is one: 0.25 → 0.25 → 0.125.
+  EXPECT_EQ(state.scale[2], 0.125);
+  // A vertex that stops reversing grows back by 1.25 per iteration up to 1 (the first of these
+  // steps is still a reversal against step 5's speed: 0.125·1.25^11 > 1).
+  for (int step = 0; step < 12; ++step) {
+    fields.speed[0] = Eigen::Vector3d::UnitX();
+    damp_speeds({0, 1}, options, fields, state);
+  }
+  EXPECT_EQ(state.scale[0], 1.0);
+  StepDampingState small;
+  small.reset(2);
+  EXPECT_THROW(damp_speeds({0, 3}, options, fields, small), Error);
+}
+
+TEST(StepDamping, ConvergesWhereForwardEulerDivergesAndLeavesAStableStepAlone) {
+  // dt·k = 2.5: plain forward Euler multiplies x by −1.5 per step.
+  const double k = 2.5, dt = 1.0;
+  StiffVertex plain, damped;
+  StepDampingState state;
+  state.reset(1);
+  for (int step = 0; step < 60; ++step) {
+    plain.set_speed(k);
+    plain.x += dt * plain.fields.speed[0].z();
+    damped.set_speed(k);
+    damp_speeds({0, 1}, StepDampingOptions{}, damped.fields, state);
+    damped.x += dt * damped.fields.speed[0].z();
+  }
+  EXPECT_GT(std::abs(plain.x), 1e9);
+  EXPECT_LT(std::abs(damped.x), 1e-6);
+  // dt·k = 0.5: no reversal ever, so the damped run is the plain one, bit for bit.
+  StiffVertex a, b;
+  state.reset(1);
+  for (int step = 0; step < 20; ++step) {
+    a.set_speed(0.5);
+    a.x += dt * a.fields.speed[0].z();
+    b.set_speed(0.5);
+    damp_speeds({0, 1}, StepDampingOptions{}, b.fields, state);
+    b.x += dt * b.fields.speed[0].z();
+  }
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(state.scale[0], 1.0);
+}
+
+TEST(StepDamping, TheWholeSpeedIsScaledSoItsZerosStay) {
+  // F = −(g·(v + H) + ∇g·N)·N with g·(v + H) = 1, ∇g·N = 3: −4·N. After two reversals (scale
+  // 0.25) the speed is −N: both terms scaled, so where F = 0 the surface stays at rest.
+  VertexFields fields;
+  fields.resize(1, 0);
+  const Eigen::Vector3d n = Eigen::Vector3d(1, 2, 2) / 3.0;
+  fields.normal[0] = n;
+  fields.defined[0] = kSpeedDefined;
+  StepDampingState state;
+  state.reset(1);
+  const Eigen::Vector3d tangent = Eigen::Vector3d(2, 1, -2) / 3.0;  // ⟂ n
+  for (int step = 0; step < 3; ++step) {
+    const double sign = step % 2 ? -1.0 : 1.0;
+    fields.photo_gradient[0] = sign * (3.0 * n + 5.0 * tangent);
+    fields.speed[0] = -sign * (1.0 + 3.0) * n;
+    damp_speeds({0, 1}, StepDampingOptions{}, fields, state);
+  }
+  EXPECT_EQ(state.scale[0], 0.25);
+  EXPECT_NEAR((fields.speed[0] - (-0.25 * (1.0 + 3.0) * n)).norm(), 0.0, 1e-15);
+  // The vertex without a defined speed is left alone.
+  fields.defined[0] = 0;
+  fields.speed[0] = Eigen::Vector3d(7, 8, 9);
+  damp_speeds({0, 1}, StepDampingOptions{}, fields, state);
+  EXPECT_EQ(fields.speed[0], Eigen::Vector3d(7, 8, 9));
+  EXPECT_EQ(state.normal_speed[0], 0.0);
+}
+
+// Fields for \p mesh with outward sphere normals, a speed everywhere and the shortest edges.
+VertexFields sphere_fields(const TriMesh& mesh) {
+  VertexFields fields;
+  fields.resize(mesh.n_vertices(), 0);
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+    fields.normal[v] = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))).normalized();
+    fields.defined[v] = kSpeedDefined;
+  }
+  compute_local_edges(mesh, all_vertices(mesh), fields);
+  return fields;
+}
+
+void scale_sphere(TriMesh& mesh, double factor) {
+  for (auto v : mesh.vertices()) mesh.set_point(v, mesh.point(v) * factor);
+}
+
+TEST(NetNormalMove, IsTheRadialGrowthOverTheWindowInShortestEdges) {
+  TriMesh mesh = icosphere(1.0, 3);
+  const VertexFields fields = sphere_fields(mesh);
+  NetNormalMove net(5);
+  // The radius grows by 0.001 per iteration: after 5 iterations each vertex has moved 0.005
+  // along its normal; the median of 0.005 / (shortest edge at the final radius) is known.
+  double radius = 1.0;
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_TRUE(std::isnan(net.record(mesh, fields))) << i;  // fewer than 6 positions
+    scale_sphere(mesh, (radius + 0.001) / radius);
+    radius += 0.001;
+  }
+  std::vector<double> expected;
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) expected.push_back(0.005 / fields.local_edge[v]);
+  EXPECT_NEAR(net.record(mesh, fields), median_of(expected), 1e-9);
+  // An oscillation around one radius, ±0.001 in turn. Over an even window of 4 it cancels, though
+  // every single step is 0.002 long.
+  const TriMesh base = mesh;
+  NetNormalMove even(4);
+  for (int i = 0; i < 12; ++i) {
+    for (auto v : mesh.vertices()) mesh.set_point(v, base.point(v) * (1.0 + (i % 2 ? -0.001 : 0.001)));
+    const double value = even.record(mesh, fields);
+    if (i >= 4) EXPECT_NEAR(value, 0.0, 1e-12) << i;
+    else EXPECT_TRUE(std::isnan(value)) << i;
+  }
+  // reset() forgets the positions: NaN again.
+  even.reset();
+  EXPECT_TRUE(std::isnan(even.record(mesh, fields)));
+  // A vertex count change without reset is refused.
+  TriMesh other = icosphere(1.0, 2);
+  EXPECT_THROW(even.record(other, sphere_fields(other)), Error);
+  EXPECT_THROW(NetNormalMove(0), Error);
+}
+
+}  // namespace
+}  // namespace mvflow
