@@ -126,10 +126,13 @@ TEST(CliInterrupt, BatchStopsAndTheNextBatchRedoesTheInterruptedOrKilledScene) {
   for (const int number : {SIGINT, SIGKILL}) {
     fs::remove_all(out);
     {
-      Running run({"batch", scenes.string(), "-o", out.string()}, folder / "log.txt");
+      // -v: batch logs each iteration of a scene at debug level, named by the scene.
+      Running run({"-v", "batch", scenes.string(), "-o", out.string()}, folder / "log.txt");
       ASSERT_TRUE(run.wait_for("[1/2]")) << run.log();
-      // Into scene a's refinement (batch logs no iterations; the scene takes ~2 s alone).
-      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      // Into scene a's refinement, however slow the machine: its first iteration is done, so the
+      // signal cannot land while the scene loads (the scene takes ~2 s alone; a signal that came
+      // after it finished would let [2/2] start, which fails below).
+      ASSERT_TRUE(run.wait_for("a: iteration   1 ")) << run.log();
       run.signal(number);
       const int code = run.wait();
       EXPECT_EQ(code, number == SIGINT ? 130 : -SIGKILL) << run.log();

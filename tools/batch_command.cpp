@@ -115,6 +115,11 @@ Row refine_one(const BatchItem& item, const fs::path& folder, const RefineOption
     RefineControl control;
     control.threads = args.threads;
     control.cancel = &interrupt_requested();
+    // With -v, one line per iteration names the scene: a scene's progress is visible (and a test
+    // knows the refinement is under way) without the info-level lines of every scene.
+    control.on_iteration = [&](const IterationReport& r) {
+      log.debug("{}: iteration {:3d}  vertices {:7d}  {}", item.name, r.iteration, r.vertices, r.stop);
+    };
     const RefineResult result = refine_mesh(scene, initial, options, control);
     const RefineSummary& s = result.summary;
     row.iterations = s.iterations.size();

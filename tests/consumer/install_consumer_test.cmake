@@ -2,7 +2,8 @@
 # mvflow from CMake" says, checks what was installed, then configures, builds and runs the host
 # project beside this file against that prefix alone.
 #   cmake -DBUILD_DIR=<mvflow build> -DWORK_DIR=<scratch> -DVERSION=<project version>
-#         -DGENERATOR=<generator> -DCXX_COMPILER=<c++> [-DLAUNCHER=<ccache>] -P install_consumer_test.cmake
+#         -DGENERATOR=<generator> -DCXX_COMPILER=<c++> [-DLAUNCHER=<ccache>] [-DCXX_FLAGS=<flags>]
+#         [-DEXE_LINKER_FLAGS=<flags>] -P install_consumer_test.cmake
 cmake_minimum_required(VERSION 3.23)
 set(prefix ${WORK_DIR}/prefix)
 file(REMOVE_RECURSE ${WORK_DIR})
@@ -48,6 +49,14 @@ set(configure -S ${CMAKE_CURRENT_LIST_DIR} -B ${WORK_DIR}/build -G ${GENERATOR} 
   -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_PREFIX_PATH=${prefix} -DMVFLOW_EXPECTED_VERSION=${VERSION})
 if(LAUNCHER)
   list(APPEND configure -DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER})
+endif()
+# The build's own flags: a sanitizer build's libraries (tools/sanitize.sh) link only into a
+# program built with the same -fsanitize.
+if(CXX_FLAGS)
+  list(APPEND configure "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}")
+endif()
+if(EXE_LINKER_FLAGS)
+  list(APPEND configure "-DCMAKE_EXE_LINKER_FLAGS=${EXE_LINKER_FLAGS}")
 endif()
 run("configuring the consumer" ${CMAKE_COMMAND} ${configure})
 file(STRINGS ${WORK_DIR}/build/CMakeCache.txt found REGEX "^mvflow_DIR:")
