@@ -177,6 +177,11 @@ TEST(Cli, BatchContinuesPastFailuresSkipsCompleteAndShards) {
   EXPECT_FALSE(fs::exists(folder / "sharded" / "a"));
   EXPECT_TRUE(fs::exists(folder / "sharded" / "b" / "refined.ply"));
   EXPECT_EQ(run("batch " + (folder / "good.txt").string() + " --shard 2/2").exit_code, 2);  // usage
+  // A budget the stopping rules cannot work in is refused before any scene, naming the bound.
+  r = run("batch " + (folder / "good.txt").string() + " -o " + (folder / "small").string() + " --max-iterations 4");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(">= 6"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(folder / "small"));
 }
 
 }  // namespace

@@ -210,8 +210,19 @@ void add_batch_command(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   c->add_option("--preset", args->preset, "default or thesis")->check(CLI::IsMember({"default", "thesis"}))->capture_default_str();
   c->add_option("--threads", args->threads, "Threads per refinement (0 = all cores)")->capture_default_str();
-  c->add_option("--max-iterations", args->max_iterations, "Override the preset's iteration limit (0 = keep)")
-      ->check(CLI::NonNegativeNumber);
+  // The stopping rules compare the last `lookback` iterations with one before them, so no budget
+  // below lookback + 1 can be met (lookback is 5 in both presets).
+  const int smallest = StoppingOptions{}.lookback + 1;
+  c->add_option("--max-iterations", args->max_iterations,
+                "Override the preset's iteration limit (0 = keep, else >= " + std::to_string(smallest) + ")")
+      ->check(CLI::Validator(
+          [smallest](const std::string& text) -> std::string {
+            const int value = std::stoi(text);
+            if (value == 0 || value >= smallest) return {};
+            return "expected 0 (keep the preset's) or >= " + std::to_string(smallest) +
+                   " (the stopping rules' lookback + 1), got " + text;
+          },
+          "0 or >= " + std::to_string(smallest)));
   c->add_flag("--force", args->force, "Refine scenes whose outputs are already complete");
   c->callback([args, &runner] { runner = [args](spdlog::logger& log) { return run_batch(*args, log); }; });
 }
