@@ -106,7 +106,7 @@ struct IterationData {
   void adapt_step_scale();             //!< part of cfl(): the step control
   void fill_speeds();                  //!< part of cfl(): speeds of unobserved vertices
   void move(std::size_t block);        //!< the steps damped (options.damping), then P ← P + Δt·F
-  void measure_moves();                //!< serial, after the iteration: median_move
+  void measure_moves();                //!< serial, after the iteration: median_move and net_move_over_edge
   void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
   void inflate(std::size_t block);     //!< new position of Taubin's second step (taubin_pass_band > 0)
   void regularize(std::size_t block);  //!< normals at the current positions, then regularization

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "engine/model/error.h"
+#include "engine/model/one_ring.h"
 #include "engine/model/option_check.h"
 
 namespace mvflow {
@@ -20,7 +21,7 @@ void StepDampingState::reset(std::size_t n_vertices) {
 }
 
 void damp_speeds(IndexRange vertices, const StepDampingOptions& options, VertexFields& fields, StepDampingState& state) {
-  MVFLOW_CHECK(vertices.begin <= vertices.end && vertices.end <= fields.size(), "damp_speeds: range outside the fields");
+  detail::check_range(vertices, fields.size(), "damp_speeds");
   MVFLOW_CHECK(state.scale.size() == fields.size() && state.normal_speed.size() == fields.size(),
                "damp_speeds: state is not sized for the fields");
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
