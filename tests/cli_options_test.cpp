@@ -35,7 +35,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--noise-floor", {"0.05", 0.05}},
       {"--drop-views", {"2", 2}},
       {"--drop-min-views", {"6", 6}},
-      {"--spread-unobserved", {"on", true}},
+      {"--spread-unobserved", {"on", "on"}},
       {"--observed-view-angle", {"60", 60.0}},
       {"--observed-erode", {"2", 2}},
       {"--fill-unobserved", {"on", true}},

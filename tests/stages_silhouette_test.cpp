@@ -180,6 +180,14 @@ TEST(SilhouetteRims, LeaveWhatIsNoRimNearTheBoundaryOrHidden) {
   EXPECT_EQ(rim_move(rim.point, rim.normal, s.views, masks, &occluder, 0.01, whole_step(0.0)), 0.0);
   const SurfaceQuery aside(make_icosphere(0.2, 2, Eigen::Vector3d(-2, 0, -2)));
   EXPECT_GT(rim_move(rim.point, rim.normal, s.views, masks, &aside, 0.01, whole_step(0.0)), 0.0);
+  // The views counted are those whose outline the point makes: one here, none when hidden.
+  int rim_views = -1;
+  rim_move(rim.point, rim.normal, s.views, masks, &aside, 0.01, whole_step(0.0), &rim_views);
+  EXPECT_EQ(rim_views, 1);
+  rim_move(rim.point, rim.normal, s.views, masks, &occluder, 0.01, whole_step(0.0), &rim_views);
+  EXPECT_EQ(rim_views, 0);
+  rim_move(rim.point, rim.normal, s.views, masks, nullptr, 1.0, whole_step(3.0), &rim_views);
+  EXPECT_EQ(rim_views, 1);  // within the dead zone: no move, but the silhouette still observes it
   SilhouetteRimOptions bad = whole_step(0.0);
   bad.search_pixels = 0.0;
   EXPECT_THROW(bad.check(), OptionError);

@@ -205,5 +205,29 @@ TEST(UnobservedDisplacement, UnobservedAreTheVerticesWithoutSpeedGrownByTheErode
   }
 }
 
+TEST(UnobservedDisplacement, VerticesOnTheSilhouettesCountAsObservedAndAreNotEroded) {
+  const TriMesh mesh = icosphere(1.0, 3);
+  const VertexFields fields = fields_with_speed_above(mesh, -0.5);
+  std::vector<Camera> cameras = {look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 60, 64, 48)};
+  std::vector<Image> images(1, Image(64, 48));
+  const std::vector<PhotoView> views = make_photo_views(cameras, {&images[0]});
+  UnobservedDisplacementOptions options;  // erode_rings = 1
+  const std::vector<std::uint8_t> without = poorly_observed_vertices(mesh, views, fields, options);
+  // The silhouettes observe a band of the unobserved region and the ring just outside it.
+  std::vector<std::uint8_t> on_silhouette(mesh.n_vertices(), 0);
+  for (auto v : mesh.vertices()) {
+    const double y = mesh.point(v)[1];
+    on_silhouette[static_cast<std::size_t>(v.idx())] = (y > -0.75 && y < -0.6) || (y >= -0.5 && y < -0.4);
+  }
+  const std::vector<std::uint8_t> with = poorly_observed_vertices(mesh, views, fields, options, on_silhouette);
+  std::size_t cleared = 0;
+  for (std::size_t i = 0; i < with.size(); ++i) {
+    EXPECT_EQ(with[i], on_silhouette[i] ? 0 : without[i]) << i;
+    cleared += without[i] && on_silhouette[i];
+  }
+  EXPECT_GT(cleared, 10u);  // the band and the eroded ring, not an empty test
+  EXPECT_THROW(poorly_observed_vertices(mesh, views, fields, options, std::vector<std::uint8_t>(3, 0)), Error);
+}
+
 }  // namespace
 }  // namespace mvflow

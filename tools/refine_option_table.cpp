@@ -173,16 +173,18 @@ std::vector<RefineOptionEntry> make_table() {
                     [](auto& o) -> auto& { return o.photo.photo.drop_views; }));
   t.push_back(value("--drop-min-views", "drop_min_views", "photo.photo.min_views", "... while more than this many views remain",
                     [](auto& o) -> auto& { return o.photo.photo.min_views; }));
-  t.push_back(on_off("--spread-unobserved", "spread_unobserved",
+  t.push_back(choice("--spread-unobserved", "spread_unobserved",
                      "Vertices without g or ∇g take the observed surface's displacement (harmonic, from the surface "
-                     "the flow started on) when the flow converges at a resolution and at the end (on/off)",
-                     [](auto& o) -> auto& { return o.unobserved_displacement.enabled; }));
+                     "the flow started on) when the flow converges at a resolution and at the end: on, off, or auto "
+                     "(when the rims are fitted to silhouettes, which then count as observed; thesis preset: off)",
+                     {{"off", UnobservedSpread::Off}, {"on", UnobservedSpread::On}, {"auto", UnobservedSpread::Auto}},
+                     [](auto& o) -> auto& { return o.unobserved_displacement.spread; }));
   t.push_back(value("--observed-view-angle", "observed_view_angle_degrees", "unobserved_displacement.observed_angle_degrees",
-                    "--spread-unobserved on: a vertex counts as observed when it has a speed and a view within this "
+                    "--spread-unobserved: a vertex counts as observed when it has a speed and a view within this "
                     "angle of its normal (degrees)",
                     [](auto& o) -> auto& { return o.unobserved_displacement.observed_angle_degrees; }));
   t.push_back(value("--observed-erode", "observed_erode_rings", "unobserved_displacement.erode_rings",
-                    "--spread-unobserved on: shrink the observed set by this many rings before following it",
+                    "--spread-unobserved: shrink the observed set by this many rings before following it",
                     [](auto& o) -> auto& { return o.unobserved_displacement.erode_rings; }));
   t.push_back(on_off("--fill-unobserved", "fill_unobserved",
                      "Vertices without g or ∇g move with their observed neighbours (on/off)",

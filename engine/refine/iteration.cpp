@@ -79,6 +79,7 @@ void IterationData::reset_topology() {
   step_scale = 1.0;  // Σg/vertex of another mesh says nothing about the steps on this one
   previous_g_per_vertex = 0.0;
   damping.reset(mesh.n_vertices());
+  on_rim.assign(mesh.n_vertices(), 0);
   net_move.reset();
   net_move_over_edge = std::numeric_limits<double>::quiet_NaN();
 }
@@ -237,7 +238,7 @@ void IterationData::commit(std::size_t block) {
 void IterationData::fit_rims(std::size_t block) {
   run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Rims)], [&] {
     fit_silhouette_rims(mesh, blocks[block], *rim_views, *rim_masks, surface.get(), mean_edge, options.rims, fields,
-                        new_positions);
+                        new_positions, &on_rim);
   });
 }
 

@@ -54,6 +54,7 @@ RefineOptions thesis_preset() {
   options.refinement_schedule = RefinementSchedule::EveryIteration;
   options.stopping.test = ConvergenceTest::EachLookback;
   options.rims.fit = RimFit::Off;
+  options.unobserved_displacement.spread = UnobservedSpread::Off;
   return options;
 }
 

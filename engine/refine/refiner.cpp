@@ -140,6 +140,8 @@ class Refinement {
       data_.rim_masks = &rim_masks_;
       data_.rim_views = &full_views_;
     }
+    const UnobservedSpread spread = options.unobserved_displacement.spread;
+    spreads_ = spread == UnobservedSpread::On || (spread == UnobservedSpread::Auto && data_.rim_masks);
   }
 
   RefineResult run() {
@@ -152,6 +154,9 @@ class Refinement {
     if (control_.logger && data_.rim_masks)
       control_.logger->info("fitting the rims to the silhouettes (threshold {}){}", options_.silhouettes.threshold,
                             options_.rims.fit == RimFit::Auto ? ": every view's border is dark" : "");
+    if (control_.logger && spreads_)
+      control_.logger->info("unobserved vertices follow the observed surface{}",
+                            data_.rim_masks ? " and the silhouette rims" : "");
     prepare();
     summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, options_).sum_g_per_vertex;
 
@@ -247,7 +252,7 @@ class Refinement {
     if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
     apply_smoothing(mesh_, options_.smoothing);
     apply_regularization(mesh_, options_.regularization);
-    if (options_.unobserved_displacement.enabled) reference_ = positions_of(mesh_);
+    if (spreads_) reference_ = positions_of(mesh_);
   }
 
   // Removes the folds of the current surface (UntanglingOptions), counted for the summary;
@@ -280,9 +285,10 @@ class Refinement {
   // (UnobservedDisplacementOptions); the fields still describe the current topology.
   // True when vertices moved.
   bool spread_unobserved() {
-    if (!options_.unobserved_displacement.enabled) return false;
+    if (!spreads_) return false;
     const std::vector<std::uint8_t> poor =
-        poorly_observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement);
+        poorly_observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement,
+                                 data_.rim_masks ? std::span<const std::uint8_t>(data_.on_rim) : std::span<const std::uint8_t>{});
     const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const DisplacementResult result = spread_displacement(mesh_, reference_, poor);
     if (result.moved_vertices > 0) limit_to_silhouettes(before);
@@ -306,7 +312,7 @@ class Refinement {
     const auto start = Clock::now();
     const std::size_t faces = mesh_.n_faces();
     const RefinementResult result = refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
-    if (options_.unobserved_displacement.enabled) extend_reference(reference_, result.parents);
+    if (spreads_) extend_reference(reference_, result.parents);
     report.refined_faces += mesh_.n_faces() - faces;
     report.declined_vertices += result.declined;
     seconds += seconds_since(start);
@@ -390,6 +396,7 @@ class Refinement {
   std::size_t untangled_pairs_ = 0;
   // Where each vertex was when the flow started (UnobservedDisplacementOptions), midpoints for the
   // vertices refinement added; empty when the option is off.
+  bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   std::vector<Eigen::Vector3d> reference_;
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
   std::optional<SilhouetteConstraint> inside_;

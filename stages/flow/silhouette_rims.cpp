@@ -83,7 +83,7 @@ std::vector<Mask> rim_silhouettes(const std::vector<PhotoView>& views, const Sil
 
 double rim_move(const Eigen::Vector3d& X, const Eigen::Vector3d& N, const std::vector<PhotoView>& views,
                 const std::vector<Mask>& masks, const SurfaceQuery* surface, double mean_edge,
-                const SilhouetteRimOptions& options) {
+                const SilhouetteRimOptions& options, int* rim_views) {
   const double sin_rim = std::sin(options.rim_angle_degrees * std::numbers::pi / 180.0);
   double total = 0.0;
   int rims = 0;
@@ -116,20 +116,25 @@ double rim_move(const Eigen::Vector3d& X, const Eigen::Vector3d& N, const std::v
     total += sign * std::max(0.0, pixels - options.dead_zone_pixels) / pixels_per_unit;
     ++rims;
   }
+  if (rim_views) *rim_views = rims;
   return rims > 0 ? options.step * total / rims : 0.0;
 }
 
 void fit_silhouette_rims(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
                          const std::vector<Mask>& masks, const SurfaceQuery* surface, double mean_edge,
                          const SilhouetteRimOptions& options, const VertexFields& fields,
-                         std::vector<Eigen::Vector3d>& new_positions) {
+                         std::vector<Eigen::Vector3d>& new_positions, std::vector<std::uint8_t>* on_rim) {
   MVFLOW_CHECK(masks.size() == views.size(), "silhouette rims: one mask per view");
   MVFLOW_CHECK(new_positions.size() == mesh.n_vertices(), "silhouette rims: one new position per vertex");
+  MVFLOW_CHECK(!on_rim || on_rim->size() == mesh.n_vertices(), "silhouette rims: one rim flag per vertex");
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
     const Eigen::Vector3d& N = fields.normal[v];
-    new_positions[v] =
-        (fields.defined[v] & kNormalDefined) ? P + rim_move(P, N, views, masks, surface, mean_edge, options) * N : P;
+    int rim_views = 0;
+    new_positions[v] = (fields.defined[v] & kNormalDefined)
+                           ? P + rim_move(P, N, views, masks, surface, mean_edge, options, &rim_views) * N
+                           : P;
+    if (on_rim) (*on_rim)[v] = rim_views > 0;
   }
 }
 

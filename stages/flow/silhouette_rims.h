@@ -71,15 +71,18 @@ std::vector<Mask> rim_silhouettes(const std::vector<PhotoView>& views, const Sil
 //! silhouette boundary in every view where X is an unoccluded rim, averaged over those views
 //! and scaled by options.step; 0 where X is a rim of no view or every boundary lies within the
 //! dead zone. \p surface answers the occlusion test (the current mesh; nullptr: none).
+//! \p rim_views, when given, receives the number of views whose outline X makes (within the
+//! search, dead zone or not): the silhouettes observe X.
 double rim_move(const Eigen::Vector3d& X, const Eigen::Vector3d& N, const std::vector<PhotoView>& views,
                 const std::vector<Mask>& masks, const SurfaceQuery* surface, double mean_edge,
-                const SilhouetteRimOptions& options);
+                const SilhouetteRimOptions& options, int* rim_views = nullptr);
 
 //! new_positions[v] = P + rim_move(P, N)·N for every vertex of \p vertices with a normal (the
-//! others keep P). Reads fields.normal.
+//! others keep P). Reads fields.normal. \p on_rim, when given (one flag per vertex), gets 1 where
+//! the vertex makes some view's outline (rim_move's rim_views > 0), 0 elsewhere in \p vertices.
 void fit_silhouette_rims(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
                          const std::vector<Mask>& masks, const SurfaceQuery* surface, double mean_edge,
                          const SilhouetteRimOptions& options, const VertexFields& fields,
-                         std::vector<Eigen::Vector3d>& new_positions);
+                         std::vector<Eigen::Vector3d>& new_positions, std::vector<std::uint8_t>* on_rim = nullptr);
 
 }  // namespace mvflow

@@ -108,9 +108,12 @@ std::size_t drop_unanchored(const TriMesh& mesh, std::vector<std::uint8_t>& is_f
 
 std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
                                                    const VertexFields& fields,
-                                                   const UnobservedDisplacementOptions& options) {
+                                                   const UnobservedDisplacementOptions& options,
+                                                   std::span<const std::uint8_t> on_silhouette) {
   options.check();
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "poorly_observed_vertices: fields not sized for the mesh");
+  MVFLOW_CHECK(on_silhouette.empty() || on_silhouette.size() == fields.size(),
+               "poorly_observed_vertices: the silhouette flags are not sized for the mesh");
   const double cos_observed = std::cos(options.observed_angle_degrees * std::numbers::pi / 180.0);
   std::vector<std::uint8_t> poor(fields.size(), 1);
   for (std::uint32_t v = 0; v < fields.size(); ++v) {
@@ -139,6 +142,8 @@ std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const st
         }
     poor.swap(next);
   }
+  for (std::size_t v = 0; v < on_silhouette.size(); ++v)
+    if (on_silhouette[v]) poor[v] = 0;
   return poor;
 }
 
