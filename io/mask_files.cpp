@@ -60,4 +60,12 @@ Image read_mask_image(const fs::path& file, const View& view, std::size_t index)
   return image;
 }
 
+std::shared_ptr<ImageStore> mask_store(const fs::path& folder, const Scene& scene) {
+  std::vector<fs::path> files;
+  for (std::size_t i = 0; i < scene.size(); ++i) files.push_back(find_mask_file(folder, scene.views[i], i));
+  return std::make_shared<ImageStore>(scene.size(), [files, views = scene.views](std::size_t i) {
+    return read_mask_image(files[i], views[i], i);
+  });
+}
+
 }  // namespace mvflow::io

@@ -5,10 +5,12 @@
 // image into a mask).
 
 #include <filesystem>
+#include <memory>
 #include <string>
 
 #include "engine/model/camera.h"
 #include "engine/model/image.h"
+#include "engine/model/scene.h"
 
 namespace mvflow::io {
 
@@ -22,5 +24,11 @@ std::filesystem::path find_mask_file(const std::filesystem::path& folder, const 
 //! Reads a mask image and checks that it has the size of \p view's camera.
 //! \throw as io::read_image; InputError naming the file, both sizes and the view otherwise.
 Image read_mask_image(const std::filesystem::path& file, const View& view, std::size_t index);
+
+//! The masks of every view of \p scene in \p folder, for Scene::masks: each file is found now (so a
+//! missing or ambiguous one stops the job before any work) and decoded on first use, its size
+//! checked against its camera's.
+//! \throw as find_mask_file.
+std::shared_ptr<ImageStore> mask_store(const std::filesystem::path& folder, const Scene& scene);
 
 }  // namespace mvflow::io

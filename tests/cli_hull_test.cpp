@@ -1,12 +1,16 @@
-// `mvflow hull` as a user runs it: the mesh it writes, mask files, and bad input.
+// `mvflow hull` as a user runs it: the mesh it writes, mask files, and bad input; `mvflow synth`'s
+// hull start and mask files.
 
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 
+#include <cmath>
+#include <numbers>
 #include <regex>
 
 #include "io/image_io.h"
+#include "stages/flow/silhouette.h"
 #include "test_support.h"
 
 namespace mvflow {
@@ -163,6 +167,40 @@ TEST(CliSynth, InitHullIsAClosedMeshCloseToTheTruth) {
   ASSERT_TRUE(std::regex_search(r.output, mean, std::regex("mean  symmetric +([0-9.e+-]+)"))) << r.output;
   EXPECT_LT(std::stod(mean[1]), 0.02) << r.output;
   EXPECT_EQ(run_mvflow("synth --init hull:2 -o " + scene).exit_code, 2);
+}
+
+// `mvflow synth --masks`: the truth's exact silhouettes. A unit sphere seen from distance 3 by a
+// camera aimed at its centre has a disc of radius f·tan(asin(1/3)) pixels for its outline: 48.99
+// pixels at 160×120 with the 60° field of view (f = 80 / tan 30°), 7540 pixels of area.
+TEST(CliSynth, MasksAreTheTruthsExactSilhouettes) {
+  test::ScratchFolder folder;
+  const fs::path scene = folder / "scene";
+  CommandResult r = run_mvflow("synth --amplitude 0 --views 4 --width 160 --height 120 --level 5 --masks -o " +
+                               scene.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const double f = 80.0 / std::tan(30.0 * std::numbers::pi / 180.0);
+  const double radius = f * std::tan(std::asin(1.0 / 3.0));
+  for (const char* name : {"view_000.png", "view_003.png"}) {
+    const Mask mask = mask_from_image(io::read_image(scene / "masks" / name));
+    ASSERT_EQ(mask.width, 160);
+    ASSERT_EQ(mask.height, 120);
+    // Inscribed triangles make the polyhedron's outline a little smaller than the sphere's.
+    EXPECT_NEAR(static_cast<double>(mask.count()), std::numbers::pi * radius * radius, 0.01 * 7540.0) << name;
+    // Pixels well inside or well outside the disc are object or background.
+    for (int y = 0; y < 120; ++y)
+      for (int x = 0; x < 160; ++x) {
+        const double d = std::hypot(x - 79.5, y - 59.5);
+        if (d < radius - 1.5) {
+          EXPECT_TRUE(mask.at(x, y)) << name << " " << x << "," << y;
+        } else if (d > radius + 1.5) {
+          EXPECT_FALSE(mask.at(x, y)) << name << " " << x << "," << y;
+        }
+      }
+  }
+  // Without the flag there are none.
+  r = run_mvflow("synth --amplitude 0 --views 4 --width 160 --height 120 --level 3 -o " + (folder / "plain").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(folder / "plain" / "masks"));
 }
 
 }  // namespace

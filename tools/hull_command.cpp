@@ -103,13 +103,9 @@ std::vector<Mask> silhouettes(const HullArguments& args, const Scene& scene, con
 void save_masks(const std::filesystem::path& folder, const Scene& scene, const std::vector<std::size_t>& used,
                 const std::vector<Mask>& masks) {
   std::filesystem::create_directories(folder);
-  for (std::size_t k = 0; k < masks.size(); ++k) {
-    Image image(masks[k].width, masks[k].height);
-    float* rgb = image.data();
-    for (std::size_t p = 0; p < masks[k].inside.size(); ++p)
-      if (masks[k].inside[p]) rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = 1.0f;
-    io::write_png(folder / (std::filesystem::path(scene.views[used[k]].image_name).stem().string() + ".png"), image);
-  }
+  for (std::size_t k = 0; k < masks.size(); ++k)
+    io::write_png(folder / (std::filesystem::path(scene.views[used[k]].image_name).stem().string() + ".png"),
+                  mask_image(masks[k]));
 }
 
 int run_hull(const HullArguments& args, spdlog::logger& log) {

@@ -9,6 +9,7 @@
 #include "engine/model/error.h"
 #include "engine/refine/refiner.h"
 #include "io/atomic_write.h"
+#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
@@ -26,6 +27,7 @@ struct RefineArguments {
   std::string mesh;
   std::string output;
   std::string report;
+  std::string masks;
   std::string preset = "default";
   bool ascii = false;
   int threads = 0;
@@ -36,7 +38,8 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   // Before the scene is read: a refinement that cannot write its result is not started.
   io::check_writable(args.output);
   if (!args.report.empty()) io::check_writable(args.report);
-  const Scene scene = io::load_scene(args.scene);
+  Scene scene = io::load_scene(args.scene);
+  if (!args.masks.empty()) scene.masks = io::mask_store(args.masks, scene);
   std::string mesh_file = args.mesh;
   if (mesh_file.empty() && scene.mesh_file) mesh_file = scene.mesh_file->string();
   if (mesh_file.empty()) throw InputError(args.scene, 0, "no initial mesh: pass --mesh FILE or put init.ply in the scene folder");
@@ -69,6 +72,7 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   }
   if (!args.report.empty()) {
     const nlohmann::json inputs = {{"scene", scene.folder.string()}, {"mesh", mesh_file}, {"views", scene.size()},
+                                   {"masks", args.masks.empty() ? nlohmann::json() : nlohmann::json(args.masks)},
                                    {"photo_kernel", detail::active_photo_kernel().name},
                                    {"threads", args.threads}};
     io::write_report(args.report, s, inputs, refine_options_json(options, args.preset));
@@ -96,6 +100,10 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("-o,--output", args->output, "Refined mesh (PLY with colour and quality = g; format by extension)")
       ->required();
   c->add_option("--report", args->report, "JSON report (per iteration and per stage)");
+  c->add_option("--masks", args->masks,
+                "Folder of silhouette masks, one per view named after its photograph (object: any channel > 0): the "
+                "rims are fitted to them (with --fit-silhouettes auto or on) and anchor the unobserved spread, and "
+                "--keep-inside-silhouettes uses them, instead of thresholded photographs");
   c->add_option("--preset", args->preset, "Parameter set: default or thesis (exactly the thesis's B.7 values)")
       ->check(CLI::IsMember({"default", "thesis"}))
       ->capture_default_str();

@@ -44,6 +44,7 @@ struct Settings {
   double diffuse = 0.65;
   std::string light = "0.35,0.8,0.5";
   bool flat = false;
+  bool masks = false;  // also write masks/<view>.png, the truth's exact silhouettes
   double specular = 0.0;
   double shininess = 40.0;
   double noise = 0.0;
@@ -193,6 +194,7 @@ SynthOptions to_options(const Settings& s) {
   o.albedo = s.albedo == "uv" ? AlbedoKind::Uv : s.albedo == "solid" ? AlbedoKind::Solid : AlbedoKind::Auto;
   o.feature_size = s.feature_size;
   o.octaves = s.octaves;
+  o.masks = s.masks;
   o.background_radius = s.background_radius;
   o.bbox_margin = s.bbox_margin;
   std::vector<double> v;
@@ -308,6 +310,7 @@ nlohmann::json record(const SynthArguments& args, const Settings& s, const Loade
   j["albedo"] = {{"requested", s.albedo}, {"used", scene.uv_albedo ? "uv" : "solid"},
                  {"feature_size", s.feature_size}, {"octaves", s.octaves}};
   j["seed"] = s.seed;
+  j["masks"] = s.masks;
   j["render"] = {{"ambient", s.ambient},   {"diffuse", s.diffuse},       {"light", s.light},
                  {"shading", s.flat ? "flat" : "smooth"},               {"specular", s.specular},
                  {"shininess", s.shininess}, {"noise", s.noise},      {"supersample", s.supersample},
@@ -334,6 +337,10 @@ void write_scene(const fs::path& folder, const SynthScene& scene, const Settings
     for (const char* stale : {"synth_par.txt", "cameras.txt", "images.txt"}) fs::remove(folder / stale);
   }
   for (std::size_t i = 0; i < scene.views.size(); ++i) io::write_png(folder / scene.views[i].image_name, scene.images[i]);
+  if (!scene.silhouettes.empty()) fs::create_directories(folder / "masks");
+  for (std::size_t i = 0; i < scene.silhouettes.size(); ++i)
+    io::write_png(folder / "masks" / (fs::path(scene.views[i].image_name).stem().string() + ".png"),
+                  mask_image(scene.silhouettes[i]));
   if (s.cameras == "colmap") io::write_colmap(folder, scene.views);
   else io::write_middlebury(folder / "synth_par.txt", scene.views);
   io::write_mesh(folder / "truth.ply", scene.truth);
@@ -407,6 +414,13 @@ void add_synth_command(CLI::App& app, Runner& runner) {
   bind_option(c, a, "--ambient", &Settings::ambient, "Ambient light (fraction of the albedo)")->check(CLI::Range(0.0, 2.0));
   bind_option(c, a, "--diffuse", &Settings::diffuse, "Directional light's Lambertian weight")->check(CLI::Range(0.0, 2.0));
   bind_option(c, a, "--light", &Settings::light, "Direction towards the light, X,Y,Z")->check(numbers(3, "X,Y,Z", check_light));
+  {
+    CLI::Option* masks = c->add_flag("--masks", args->settings.masks,
+                                     "Also write masks/<view>.png: the truth's exact silhouettes (for refine --masks)");
+    args->fill_from_preset.push_back([masks](const Settings& p, Settings& s) {
+      if (masks->count() == 0) s.masks = p.masks;
+    });
+  }
   {
     CLI::Option* flat = c->add_flag("--flat", args->settings.flat, "Shade with face normals (default: smooth)");
     args->fill_from_preset.push_back([flat](const Settings& p, Settings& s) {

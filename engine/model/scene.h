@@ -46,6 +46,9 @@ struct Scene {
   std::string camera_format;             //!< "colmap", "colmap-bin", "middlebury" or "photomodeler"
   std::vector<View> views;               //!< in the order of the camera file
   std::shared_ptr<ImageStore> images;    //!< one image per view
+  //! One silhouette image per view (a pixel is object where a channel is non-zero), e.g. from
+  //! io::mask_store; null: the refinement thresholds the photographs where their border is dark.
+  std::shared_ptr<ImageStore> masks;
   std::optional<std::filesystem::path> mesh_file;  //!< initial mesh found in the folder, if any
   BoundingBox bounding_box;              //!< region that holds the object (may be empty)
   std::string bounding_box_source;       //!< where bounding_box came from, for reports

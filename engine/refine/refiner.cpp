@@ -25,6 +25,7 @@
 #include "stages/flow/regularization.h"
 #include "stages/topology/remeshing.h"
 #include "stages/topology/self_intersections.h"
+#include "stages/flow/silhouette.h"
 #include "stages/flow/silhouette_constraint.h"
 #include "stages/flow/silhouette_rims.h"
 #include "stages/flow/smoothing.h"
@@ -40,6 +41,14 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The scene indices of the views not excluded, in scene order.
+std::vector<std::size_t> kept_view_indices(const Scene& scene, const std::vector<int>& excluded) {
+  std::vector<std::size_t> kept;
+  for (std::size_t i = 0; i < scene.size(); ++i)
+    if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) == excluded.end()) kept.push_back(i);
+  return kept;
 }
 
 // The views the refinement may use, in scene order without the excluded ones. The exclusions are
@@ -60,9 +69,24 @@ std::vector<PhotoView> usable_views(const Scene& scene, const std::vector<int>& 
                        std::to_string(scene.size() - left) + " excluded)");
   std::vector<PhotoView> all = make_photo_views(scene);
   std::vector<PhotoView> kept;
-  for (std::size_t i = 0; i < all.size(); ++i)
-    if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) == excluded.end()) kept.push_back(all[i]);
+  for (std::size_t i : kept_view_indices(scene, excluded)) kept.push_back(all[i]);
   return kept;
+}
+
+// The silhouettes of the scene's views \p kept from its mask images (Scene::masks), as given: no
+// threshold, no hole filling.
+std::vector<Mask> given_silhouettes(const Scene& scene, std::span<const std::size_t> kept) {
+  std::vector<Mask> masks;
+  for (std::size_t i : kept) {
+    const Image& image = scene.masks->get(i);
+    const Camera& camera = scene.views[i].camera;
+    if (image.width() != camera.width() || image.height() != camera.height())
+      throw InputError("the mask of view " + std::to_string(i) + " is " + std::to_string(image.width()) + "x" +
+                       std::to_string(image.height()) + " pixels, but the view is " + std::to_string(camera.width()) +
+                       "x" + std::to_string(camera.height()));
+    masks.push_back(mask_from_image(image));
+  }
+  return masks;
 }
 
 // g at every vertex of the current mesh (normals, visibility, g; no gradient), and the mean
@@ -131,12 +155,19 @@ class Refinement {
     for (int level = 0; level < options.image_levels; ++level)
       levels_.push_back(half_resolution(level == 0 ? full_views_ : levels_.back()->views));
     if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
+    // Mask images, when the scene has them, stand for the thresholded photographs everywhere.
+    rims_from_masks_ = scene.masks != nullptr;
+    const std::vector<Mask> given =
+        rims_from_masks_ ? given_silhouettes(scene, kept_view_indices(scene, options.excluded_views)) : std::vector<Mask>{};
     if (options.keep_inside_silhouettes) {
-      inside_.emplace(full_views_, threshold_silhouettes(full_views_, options.silhouettes));
+      std::vector<Mask> inside = given;
+      for (Mask& mask : inside) mask = dilate_mask(mask, options.silhouettes.dilate);
+      inside_.emplace(full_views_, rims_from_masks_ ? inside : threshold_silhouettes(full_views_, options.silhouettes));
       data_.inside = &*inside_;
     }
-    if (fits_rims(full_views_, options.silhouettes.threshold, options.rims)) {
-      rim_masks_ = rim_silhouettes(full_views_, options.silhouettes, options.rims);
+    if (rims_from_masks_ ? options.rims.fit != RimFit::Off
+                         : fits_rims(full_views_, options.silhouettes.threshold, options.rims)) {
+      rim_masks_ = rims_from_masks_ ? given : rim_silhouettes(full_views_, options.silhouettes, options.rims);
       data_.rim_masks = &rim_masks_;
       data_.rim_views = &full_views_;
     }
@@ -151,7 +182,9 @@ class Refinement {
     summary.initial_vertices = mesh_.n_vertices();
     summary.initial_faces = mesh_.n_faces();
     progress(0, RefineStage::Preparing);
-    if (control_.logger && data_.rim_masks)
+    if (control_.logger && data_.rim_masks && rims_from_masks_)
+      control_.logger->info("fitting the rims to the silhouettes of the mask images");
+    else if (control_.logger && data_.rim_masks)
       control_.logger->info("fitting the rims to the silhouettes (threshold {}){}", options_.silhouettes.threshold,
                             options_.rims.fit == RimFit::Auto ? ": every view's border is dark" : "");
     if (control_.logger && spreads_)
@@ -396,6 +429,7 @@ class Refinement {
   std::size_t untangled_pairs_ = 0;
   // Where each vertex was when the flow started (UnobservedDisplacementOptions), midpoints for the
   // vertices refinement added; empty when the option is off.
+  bool rims_from_masks_ = false;  //!< the silhouettes are the scene's mask images (Scene::masks)
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   std::vector<Eigen::Vector3d> reference_;
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes

@@ -40,6 +40,14 @@ Mask mask_from_image(const Image& image) {
   return mask;
 }
 
+Image mask_image(const Mask& mask) {
+  Image image(mask.width, mask.height);
+  float* rgb = image.data();
+  for (std::size_t p = 0; p < mask.inside.size(); ++p)
+    if (mask.inside[p]) rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = 1.0f;
+  return image;
+}
+
 Mask dilate_mask(const Mask& mask, int radius) {
   MVFLOW_CHECK(radius >= 0, "dilation radius must be non-negative");
   if (radius == 0) return mask;

@@ -41,6 +41,9 @@ Mask threshold_silhouette(const Image& image, const SilhouetteOptions& options =
 //! A mask from a mask image: every pixel whose largest channel is non-zero is object.
 Mask mask_from_image(const Image& image);
 
+//! The mask as a mask image: object white, the rest black (mask_from_image reads it back).
+Image mask_image(const Mask& mask);
+
 //! \p mask dilated by a disc of \p radius pixels (a pixel becomes object when an object pixel
 //! lies within Euclidean distance \p radius). radius 0 returns the mask unchanged.
 Mask dilate_mask(const Mask& mask, int radius);

@@ -23,7 +23,7 @@ namespace mvflow {
 enum class RimFit {
   Off,
   On,
-  Auto,  //!< on when every view's border is background (dark_background)
+  Auto,  //!< on when every view's border is background (dark_background) or the scene has masks
 };
 
 struct SilhouetteRimOptions {

@@ -32,14 +32,10 @@ Mask truth_silhouette(const SurfaceQuery& truth, const Camera& camera) {
   return mask;
 }
 
-// The visual hull of the truth's exact silhouettes, remeshed to the initial mesh's vertex count.
-IndexedMesh hull_initial_mesh(const SynthScene& scene, const SurfaceQuery& truth, int vertices) {
+// The visual hull of the truth's exact \p silhouettes, remeshed to the initial mesh's vertex count.
+IndexedMesh hull_initial_mesh(const SynthScene& scene, const std::vector<Mask>& silhouettes, int vertices) {
   std::vector<Camera> cameras;
-  std::vector<Mask> silhouettes;
-  for (const View& view : scene.views) {
-    cameras.push_back(view.camera);
-    silhouettes.push_back(truth_silhouette(truth, view.camera));
-  }
+  for (const View& view : scene.views) cameras.push_back(view.camera);
   HullMeshOptions options;
   options.vertices = vertices;
   return make_hull_mesh(cameras, silhouettes, scene.bounding_box, options).mesh;
@@ -128,7 +124,11 @@ SynthScene make_synth_scene(const IndexedMesh& truth, std::shared_ptr<const Imag
       make_synth_renderer(truth, std::move(uv_texture), options, scene.centre, scene.radius, &scene.uv_albedo);
   scene.images.reserve(scene.views.size());
   for (std::size_t i = 0; i < scene.views.size(); ++i) scene.images.push_back(renderer.render(scene.views[i].camera, i));
-  if (init.kind == InitialMeshKind::Hull) scene.initial = hull_initial_mesh(scene, renderer.surface(), init.vertices);
+  std::vector<Mask> silhouettes;
+  if (options.masks || init.kind == InitialMeshKind::Hull)
+    for (const View& view : scene.views) silhouettes.push_back(truth_silhouette(renderer.surface(), view.camera));
+  if (init.kind == InitialMeshKind::Hull) scene.initial = hull_initial_mesh(scene, silhouettes, init.vertices);
+  if (options.masks) scene.silhouettes = std::move(silhouettes);
   return scene;
 }
 

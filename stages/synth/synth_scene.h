@@ -12,6 +12,7 @@
 #include "engine/model/image.h"
 #include "engine/model/mesh.h"
 #include "engine/model/scene.h"
+#include "stages/flow/silhouette.h"
 #include "stages/synth/synth_cameras.h"
 #include "stages/synth/synth_initial_mesh.h"
 #include "stages/synth/synth_objects.h"
@@ -35,6 +36,7 @@ struct SynthOptions {
   RenderOptions render;       //!< render.seed is derived from seed
   RigOptions rig;
   InitialMeshOptions init;    //!< init.seed is derived from seed
+  bool masks = false;         //!< also the truth's exact silhouettes (SynthScene::silhouettes)
   //! \throw InputError naming the field when a value is out of range.
   void check() const;
 };
@@ -56,6 +58,9 @@ struct SynthScene {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  //!< what the cameras look at
   double radius = 1.0;         //!< largest distance of a truth vertex from the centre
   bool uv_albedo = false;      //!< whether the UV texture was used
+  //! With SynthOptions::masks: the truth's exact silhouette per view (a pixel is object when the
+  //! ray through its centre meets the truth, whatever the background and the texture).
+  std::vector<Mask> silhouettes;
 };
 
 //! Renders the scene of \p truth (a closed mesh, ideally centred at the origin). \p uv_texture
