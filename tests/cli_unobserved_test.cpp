@@ -38,6 +38,15 @@ CapErrors cap_errors(const fs::path& mesh_file) {
   return {cap / in_cap, observed / in_band};
 }
 
+// Completeness against the sampled truth: every part of the sphere is near \p mesh.
+void expect_complete(const fs::path& mesh, const fs::path& scene, const fs::path& folder) {
+  const fs::path json = folder / (mesh.stem().string() + "_eval.json");
+  const auto eval = test::run_mvflow("eval " + mesh.string() + " " + (scene / "truth.ply").string() +
+                                     " --samples 20000 --json " + json.string());
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  EXPECT_NE(test::read_text(json).find("\"completeness\": 1.0"), std::string::npos) << test::read_text(json);
+}
+
 TEST(CliUnobserved, AGrazingCapFollowsTheObservedSurface) {
   const test::ScratchFolder folder;
   const fs::path scene = folder / "scene";
@@ -65,12 +74,7 @@ TEST(CliUnobserved, AGrazingCapFollowsTheObservedSurface) {
   const CapErrors with = cap_errors(folder / "on.ply");
   EXPECT_LT(with.cap, 2 * with.observed);
   EXPECT_LT(with.observed, 1.25 * without.observed);
-  // Completeness against the sampled truth: every part of the sphere is near the mesh.
-  const auto eval = test::run_mvflow("eval " + (folder / "on.ply").string() + " " + (scene / "truth.ply").string() +
-                                     " --samples 20000 --json " + (folder / "eval.json").string());
-  ASSERT_EQ(eval.exit_code, 0) << eval.output;
-  EXPECT_NE(test::read_text(folder / "eval.json").find("\"completeness\": 1.0"), std::string::npos)
-      << test::read_text(folder / "eval.json");
+  expect_complete(folder / "on.ply", scene, folder.path());
 }
 
 TEST(CliUnobserved, OnABlackBackgroundTheDefaultSpreadsAnchoredAtTheRims) {
@@ -95,11 +99,7 @@ TEST(CliUnobserved, OnABlackBackgroundTheDefaultSpreadsAnchoredAtTheRims) {
   const CapErrors without = cap_errors(folder / "off.ply"), with = cap_errors(folder / "auto.ply");
   EXPECT_LT(with.cap, 0.5 * without.cap);
   EXPECT_LT(with.observed, 1.25 * without.observed);
-  const auto eval = test::run_mvflow("eval " + (folder / "auto.ply").string() + " " + (scene / "truth.ply").string() +
-                                     " --samples 20000 --json " + (folder / "eval.json").string());
-  ASSERT_EQ(eval.exit_code, 0) << eval.output;
-  EXPECT_NE(test::read_text(folder / "eval.json").find("\"completeness\": 1.0"), std::string::npos)
-      << test::read_text(folder / "eval.json");
+  expect_complete(folder / "auto.ply", scene, folder.path());
 }
 
 TEST(CliUnobserved, OnATexturedBackgroundTheDefaultDoesNotSpread) {
@@ -145,12 +145,7 @@ TEST(CliUnobserved, MaskFilesBringTheRimsToATexturedBackground) {
   const CapErrors without = cap_errors(folder / "plain.ply"), with = cap_errors(folder / "masked.ply");
   EXPECT_LT(with.cap, 0.25 * without.cap);
   EXPECT_LT(with.observed, 1.3 * without.observed);
-  const auto eval = test::run_mvflow("eval " + (folder / "masked.ply").string() + " " +
-                                     (scene / "truth.ply").string() + " --samples 20000 --json " +
-                                     (folder / "eval.json").string());
-  ASSERT_EQ(eval.exit_code, 0) << eval.output;
-  EXPECT_NE(test::read_text(folder / "eval.json").find("\"completeness\": 1.0"), std::string::npos)
-      << test::read_text(folder / "eval.json");
+  expect_complete(folder / "masked.ply", scene, folder.path());
 
   // Bad mask folders stop the run with the file named, before anything is written.
   const fs::path out = folder / "out.ply";
