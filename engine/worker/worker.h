@@ -30,6 +30,9 @@ namespace mvflow {
 struct JobSpec {
   std::filesystem::path scene;  //!< scene folder or camera file; ignored when scene_data is set
   std::filesystem::path mesh;   //!< initial mesh; empty: the scene's init.*; ignored when mesh_data is set
+  //! Folder of mask files for the scene read from \p scene (io::mask_store); empty: none. An
+  //! in-memory scene carries its own (Scene::masks).
+  std::filesystem::path masks;
   std::shared_ptr<const Scene> scene_data;  //!< an in-memory scene (e.g. in_memory_scene())
   std::shared_ptr<const Mesh> mesh_data;    //!< an in-memory initial mesh
   RefineOptions options;

@@ -82,6 +82,28 @@ def test_refine_gives_the_programs_bits(scene, tmp_path):
     np.testing.assert_array_equal(from_arrays["vertices"], result["vertices"])
 
 
+def test_masks_give_the_programs_bits(tmp_path):
+    masked = tmp_path / "masked"
+    subprocess.run([os.environ["MVFLOW_BINARY"], "synth", "--views", "8", "--width", "160", "--height", "120",
+                    "--level", "3", "--init-vertices", "200", "--masks", "-o", str(masked)],
+                   check=True, stdout=subprocess.DEVNULL)
+    masks = masked / "masks"
+    result = mvflow.refine(masked, masks=masks, max_iterations=6, min_iterations=6)
+    plain = mvflow.refine(masked, max_iterations=6, min_iterations=6)
+    assert not np.array_equal(result["vertices"], plain["vertices"])  # the rims were fitted
+    out = tmp_path / "refined.ply"
+    subprocess.run([os.environ["MVFLOW_BINARY"], "refine", str(masked), "--masks", str(masks), "-o", str(out),
+                    "--max-iterations", "6", "--min-iterations", "6"], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    np.testing.assert_array_equal(result["vertices"], mvflow.read_mesh(out)[0])
+    worker = mvflow.Worker(threads=2)
+    job = worker.result(worker.submit(masked, masks=masks, max_iterations=6, min_iterations=6))
+    assert job["state"] == "succeeded", job["message"]
+    np.testing.assert_array_equal(job["vertices"], result["vertices"])
+    with pytest.raises(mvflow.IoError, match="mask folder"):
+        mvflow.refine(masked, masks=tmp_path / "none")
+
+
 def test_refine_options_are_checked(scene):
     with pytest.raises(mvflow.InputError, match=r"--max-view-angle: .*max_angle_degrees = 200 .*\(0, 90\]"):
         mvflow.refine(scene, max_view_angle=200)

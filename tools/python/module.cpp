@@ -27,6 +27,7 @@
 #include "engine/model/error.h"
 #include "engine/refine/refiner.h"
 #include "engine/worker/worker.h"
+#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
 #include "stages/eval/evaluation.h"
@@ -185,14 +186,17 @@ py::dict result_dict(const RefineSummary& summary, const Mesh& mesh) {
 }
 
 py::dict refine(const fs::path& scene_path, const py::object& mesh, const std::string& preset_name, int threads,
-                const py::kwargs& kwargs) {
+                const py::object& masks, const py::kwargs& kwargs) {
   const RefineOptions options = refine_options(preset_name, kwargs);
   std::optional<IndexedMesh> given;
   if (!mesh.is_none()) given = mesh_argument(mesh, "mesh");
+  const std::optional<fs::path> mask_folder =
+      masks.is_none() ? std::nullopt : std::optional<fs::path>(masks.cast<fs::path>());  // with the GIL
   RefineResult result;
   {
     py::gil_scoped_release release;
-    const Scene scene = io::load_scene(scene_path);
+    Scene scene = io::load_scene(scene_path);
+    if (mask_folder) scene.masks = io::mask_store(*mask_folder, scene);
     Mesh initial;
     if (given) {
       initial = build_mesh(*given, "mesh argument");
@@ -273,9 +277,10 @@ class PythonWorker {
   explicit PythonWorker(int threads) : worker_(options(threads)) {}
 
   Worker::JobId submit(const fs::path& scene, const py::object& mesh, const std::string& preset_name,
-                       const py::kwargs& kwargs) {
+                       const py::object& masks, const py::kwargs& kwargs) {
     JobSpec spec;
     spec.scene = scene;
+    if (!masks.is_none()) spec.masks = masks.cast<fs::path>();
     spec.options = refine_options(preset_name, kwargs);
     if (!mesh.is_none()) {
       if (is_path(mesh))
@@ -359,9 +364,9 @@ PYBIND11_MODULE(mvflow, m) {
       },
       py::arg("file"), py::arg("vertices"), py::arg("faces"), "Writes a mesh file (format from the extension), atomically");
   m.def("refine", &refine, py::arg("scene"), py::arg("mesh") = py::none(), py::arg("preset") = "default",
-        py::arg("threads") = 0,
+        py::arg("threads") = 0, py::arg("masks") = py::none(),
         "Refines the mesh (a path, (vertices, faces), or None for the scene's init.*) against the scene "
-        "(a folder or camera file). Keyword arguments are `mvflow refine` options without the dashes. Returns a "
+        "(a folder or camera file), with the silhouettes of the mask folder `masks` if given. Keyword arguments are `mvflow refine` options without the dashes. Returns a "
         "dict: vertices, faces, quality (g per vertex), status, iterations, ...");
   m.def("hull", &hull, py::arg("scene"), py::arg("threads") = 0,
         "The visual hull of the scene as (vertices, faces); keyword arguments are `mvflow hull` options "
@@ -373,7 +378,8 @@ PYBIND11_MODULE(mvflow, m) {
   py::class_<PythonWorker>(m, "Worker", "Background refinement jobs, run one after another on the worker's own thread")
       .def(py::init<int>(), py::arg("threads") = 0)
       .def("submit", &PythonWorker::submit, py::arg("scene"), py::arg("mesh") = py::none(),
-           py::arg("preset") = "default", "Queues a refine job and returns its id at once")
+           py::arg("preset") = "default", py::arg("masks") = py::none(),
+           "Queues a refine job (masks: a mask folder, as for refine) and returns its id at once")
       .def("progress", &PythonWorker::progress, py::arg("job"),
            "dict: state, stage, iteration, vertices, sum_g_per_vertex")
       .def("cancel", &PythonWorker::cancel, py::arg("job"), "Asks the job to stop; returns at once")
