@@ -184,5 +184,33 @@ TEST(Cli, BatchContinuesPastFailuresSkipsCompleteAndShards) {
   EXPECT_FALSE(fs::exists(folder / "small"));
 }
 
+TEST(Cli, BatchMasksAreEachScenesOwnAsInRefine) {
+  test::ScratchFolder folder;
+  for (const char* name : {"a", "b"}) {
+    const CommandResult r = run("synth --views 6 --width 120 --height 90 --level 3 --init-vertices 120 --masks -o " +
+                                (folder / name).string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  test::write_text(folder / "list.txt", "a\nb\n");
+  CommandResult r = run("batch " + (folder / "list.txt").string() + " -o " + (folder / "out").string() +
+                        " --max-iterations 6 --masks masks");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The same bits as refine with the scene's mask folder.
+  r = run("refine " + (folder / "b").string() + " --masks " + (folder / "b" / "masks").string() +
+          " --max-iterations 6 --min-iterations 6 -o " + (folder / "b.ply").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(test::read_text(folder / "out" / "b" / "refined.ply"), test::read_text(folder / "b.ply"));
+  r = run("refine " + (folder / "b").string() + " --max-iterations 6 --min-iterations 6 -o " + (folder / "plain.ply").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(test::read_text(folder / "plain.ply"), test::read_text(folder / "b.ply"));  // the masks mattered
+  // A scene without its masks fails alone, naming the file.
+  fs::remove_all(folder / "a" / "masks");
+  r = run("batch " + (folder / "list.txt").string() + " -o " + (folder / "again").string() +
+          " --max-iterations 6 --masks masks");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("the mask folder does not exist"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(folder / "again" / "b" / "refined.ply"));
+}
+
 }  // namespace
 }  // namespace mvflow

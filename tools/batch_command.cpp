@@ -10,6 +10,7 @@
 #include "engine/model/error.h"
 #include "engine/refine/refiner.h"
 #include "io/atomic_write.h"
+#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
@@ -30,6 +31,7 @@ struct BatchArguments {
   std::string preset = "default";
   int threads = 0;
   int max_iterations = 0;
+  std::string masks;  // each scene's mask folder, relative to the scene folder; empty: none
   bool force = false;
 };
 
@@ -107,7 +109,8 @@ Row refine_one(const BatchItem& item, const fs::path& folder, const RefineOption
                spdlog::logger& log) {
   Row row{item.name, "failed", 0, 0, 0, 0, 0, ""};
   try {
-    const Scene scene = io::load_scene(item.scene);
+    Scene scene = io::load_scene(item.scene);
+    if (!args.masks.empty()) scene.masks = io::mask_store(scene.folder / args.masks, scene);
     fs::path mesh_file = item.mesh;
     if (mesh_file.empty() && scene.mesh_file) mesh_file = *scene.mesh_file;
     if (mesh_file.empty()) throw InputError(item.scene, 0, "no initial mesh (give it in the list or put init.ply in the scene)");
@@ -210,6 +213,8 @@ void add_batch_command(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   c->add_option("--preset", args->preset, "default or thesis")->check(CLI::IsMember({"default", "thesis"}))->capture_default_str();
   c->add_option("--threads", args->threads, "Threads per refinement (0 = all cores)")->capture_default_str();
+  c->add_option("--masks", args->masks,
+                "Each scene's mask folder, relative to the scene folder (e.g. masks): as refine --masks");
   // The stopping rules compare the last `lookback` iterations with one before them, so no budget
   // below lookback + 1 can be met (lookback is 5 in both presets).
   const int smallest = StoppingOptions{}.lookback + 1;
