@@ -100,6 +100,11 @@ TEST(CliUnobserved, OnABlackBackgroundTheDefaultSpreadsAnchoredAtTheRims) {
   EXPECT_LT(with.cap, 0.5 * without.cap);
   EXPECT_LT(with.observed, 1.25 * without.observed);
   expect_complete(folder / "auto.ply", scene, folder.path());
+  // The rim flags and the spread do not depend on the threads or the engine.
+  const auto sequential = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "sequential.ply").string() +
+                                           " --threads 1 --engine sequential");
+  ASSERT_EQ(sequential.exit_code, 0) << sequential.output;
+  EXPECT_EQ(test::read_text(folder / "sequential.ply"), test::read_text(folder / "auto.ply"));
 }
 
 TEST(CliUnobserved, OnATexturedBackgroundTheDefaultDoesNotSpread) {
