@@ -205,6 +205,36 @@ TEST(PhotoConsistency, EveryInstructionSetBuildGivesTheSameBits) {
   if (builds.size() < 2) GTEST_SKIP() << "only the baseline build runs on this CPU: nothing to compare it with";
 }
 
+TEST(PhotoConsistency, EveryBuildGivesTheSameBitsBeyondItsStackBuffers) {
+  // More than 64 views and more than 32 samples per axis: the kernel's buffers move to the heap
+  // (a std::vector of AVX2 sums once came out 16-byte aligned there and faulted).
+  std::mt19937 random(8);
+  const auto [cameras, images] = random_rig(70, 0.09, 0.4, random);
+  const auto views = make_photo_views(cameras, pointers(images));
+  std::vector<std::uint16_t> all(cameras.size());
+  std::iota(all.begin(), all.end(), std::uint16_t{0});
+  const auto builds = detail::photo_kernel_builds();
+  std::uniform_real_distribution<double> coordinate(-0.5, 0.5);
+  constexpr int half = 17;
+  std::vector<PhotoValue> reference(6 * half + 1), samples(6 * half + 1);
+  int defined = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector3d X(coordinate(random), coordinate(random), coordinate(random));
+    builds.front().samples(X, 0.004, half, all, views, reference);
+    defined += reference[0].defined();
+    EXPECT_EQ(reference[0].g, builds.front().consistency(X, all, views).g);
+    for (const auto& build : builds | std::views::drop(1)) {
+      build.samples(X, 0.004, half, all, views, samples);
+      for (std::size_t k = 0; k < (reference[0].defined() ? samples.size() : 1); ++k) {
+        EXPECT_EQ(samples[k].views, reference[k].views) << build.name;
+        EXPECT_EQ(samples[k].g, reference[k].g) << build.name;
+      }
+    }
+  }
+  EXPECT_GT(defined, 15);
+  if (builds.size() < 2) GTEST_SKIP() << "only the baseline build runs on this CPU: nothing to compare it with";
+}
+
 TEST(PhotoConsistency, VanishesForWholePixelTranslations) {
   // Fronto-parallel plane z = 0, cameras at height 100 with f = 100 (one world unit is one pixel
   // on the plane), centres apart by whole units: the images are exact shifts of each other.

@@ -27,7 +27,8 @@ PhotoValue photo_consistency_5x5(const Eigen::Vector3d& X, std::span<const std::
 //! samples[0] = g(X) (the same bits as photo_consistency_5x5), then g(X + s·spacing·e_a) for
 //! a = x, y, z and s = −half..−1, 1..half (6·half values). When g(X) is undefined, only
 //! samples[0] is written. For pinhole views the projection of the samples is P·X + s·spacing·P_a
-//! (linear in s), evaluated for 8 views at once.
+//! (linear in s): per view, an axis's samples are projected a register's width at once, then each
+//! sample sums its views' patches in the order of view_ids.
 void photo_consistency_5x5_samples(const Eigen::Vector3d& X, double spacing, int half,
                                    std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
                                    std::span<PhotoValue> samples);
