@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "engine/model/parallel.h"
+
 namespace mvflow {
 
 namespace {
@@ -74,20 +76,29 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(con
           entries.emplace_back((static_cast<std::int64_t>(z) * dims.y() + y) * dims.x() + x, f);
   }
   std::sort(entries.begin(), entries.end());
+  std::vector<std::size_t> cell_begin;  // where each cell's run of entries starts, then the end
+  for (std::size_t i = 0; i < entries.size(); ++i)
+    if (i == 0 || entries[i].first != entries[i - 1].first) cell_begin.push_back(i);
+  cell_begin.push_back(entries.size());
+  // The cells in chunks, each chunk's pairs in its own list: after the sort below the result does
+  // not depend on the chunks or the threads. Serial, this test was 7 % of a whole 2-thread refine.
+  constexpr std::size_t kChunks = 64;
+  const std::size_t cells = cell_begin.size() - 1;
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found(kChunks);
+  parallel::parallel_for(std::size_t{0}, kChunks, [&](std::size_t chunk) {
+    for (std::size_t cell = cells * chunk / kChunks; cell < cells * (chunk + 1) / kChunks; ++cell)
+      for (std::size_t a = cell_begin[cell]; a < cell_begin[cell + 1]; ++a)
+        for (std::size_t b = a + 1; b < cell_begin[cell + 1]; ++b) {
+          const std::uint32_t f = entries[a].second, g = entries[b].second;
+          bool shares_vertex = false;
+          for (int p : corners[f])
+            for (int q : corners[g]) shares_vertex |= p == q;
+          if (!shares_vertex && triangles_cross(triangles[f], triangles[g]))
+            found[chunk].emplace_back(std::min(f, g), std::max(f, g));
+        }
+  });
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
-  for (std::size_t i = 0; i < entries.size();) {
-    std::size_t j = i;
-    while (j < entries.size() && entries[j].first == entries[i].first) ++j;
-    for (std::size_t a = i; a < j; ++a)
-      for (std::size_t b = a + 1; b < j; ++b) {
-        const std::uint32_t f = entries[a].second, g = entries[b].second;
-        bool shares_vertex = false;
-        for (int p : corners[f])
-          for (int q : corners[g]) shares_vertex |= p == q;
-        if (!shares_vertex && triangles_cross(triangles[f], triangles[g])) crossing.emplace_back(std::min(f, g), std::max(f, g));
-      }
-    i = j;
-  }
+  for (const auto& pairs : found) crossing.insert(crossing.end(), pairs.begin(), pairs.end());
   std::sort(crossing.begin(), crossing.end());
   crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
   return crossing;
