@@ -8,6 +8,7 @@
 
 #include "engine/model/error.h"
 #include "io/image_io.h"
+#include "io/mask_files.h"
 #include "io/text_reader.h"
 
 namespace mvflow::io {
@@ -187,6 +188,7 @@ Scene load_scene(const fs::path& path, const SceneLoadOptions& options) {
   });
   if (options.decode_images)
     for (std::size_t i = 0; i < scene.views.size(); ++i) scene.images->get(i);
+  if (!options.mask_folder.empty()) scene.masks = mask_store(options.mask_folder, scene);
 
   for (const char* name : {"init.ply", "init.obj", "init.off", "init.stl", "init.wrl"})
     if (fs::is_regular_file(scene.folder / name)) {

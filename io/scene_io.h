@@ -32,6 +32,8 @@ struct SceneLoadOptions {
   //! Decode every image now (otherwise images decode on first use; sizes are still checked
   //! from the file headers).
   bool decode_images = false;
+  //! A folder of mask files for Scene::masks (io::mask_store: every file found now); empty: none.
+  std::filesystem::path mask_folder;
 };
 
 //! Loads cameras, checks that every image exists and has its camera's size, finds the initial

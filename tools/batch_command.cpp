@@ -10,7 +10,6 @@
 #include "engine/model/error.h"
 #include "engine/refine/refiner.h"
 #include "io/atomic_write.h"
-#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
@@ -109,8 +108,8 @@ Row refine_one(const BatchItem& item, const fs::path& folder, const RefineOption
                spdlog::logger& log) {
   Row row{item.name, "failed", 0, 0, 0, 0, 0, ""};
   try {
-    Scene scene = io::load_scene(item.scene);
-    if (!args.masks.empty()) scene.masks = io::mask_store(scene.folder / args.masks, scene);
+    const Scene scene = io::load_scene(
+        item.scene, {.mask_folder = args.masks.empty() ? fs::path() : io::locate_scene(item.scene).folder / args.masks});
     fs::path mesh_file = item.mesh;
     if (mesh_file.empty() && scene.mesh_file) mesh_file = *scene.mesh_file;
     if (mesh_file.empty()) throw InputError(item.scene, 0, "no initial mesh (give it in the list or put init.ply in the scene)");

@@ -9,7 +9,6 @@
 #include "engine/model/error.h"
 #include "engine/refine/refiner.h"
 #include "io/atomic_write.h"
-#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
@@ -38,8 +37,7 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   // Before the scene is read: a refinement that cannot write its result is not started.
   io::check_writable(args.output);
   if (!args.report.empty()) io::check_writable(args.report);
-  Scene scene = io::load_scene(args.scene);
-  if (!args.masks.empty()) scene.masks = io::mask_store(args.masks, scene);
+  const Scene scene = io::load_scene(args.scene, {.mask_folder = args.masks});
   std::string mesh_file = args.mesh;
   if (mesh_file.empty() && scene.mesh_file) mesh_file = scene.mesh_file->string();
   if (mesh_file.empty()) throw InputError(args.scene, 0, "no initial mesh: pass --mesh FILE or put init.ply in the scene folder");

@@ -320,8 +320,7 @@ class Refinement {
   bool spread_unobserved() {
     if (!spreads_) return false;
     const std::vector<std::uint8_t> poor =
-        poorly_observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement,
-                                 data_.rim_masks ? std::span<const std::uint8_t>(data_.on_rim) : std::span<const std::uint8_t>{});
+        poorly_observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement, data_.on_rim);
     const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const DisplacementResult result = spread_displacement(mesh_, reference_, poor);
     if (result.moved_vertices > 0) limit_to_silhouettes(before);

@@ -3,7 +3,6 @@
 #include <atomic>
 
 #include "engine/model/error.h"
-#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
 
@@ -170,12 +169,9 @@ void Worker::run_jobs() {
 void Worker::run(Job& job) {
   JobOutcome outcome;
   try {
-    std::shared_ptr<const Scene> scene = job.spec.scene_data;
-    if (!scene) {
-      auto loaded = std::make_shared<Scene>(io::load_scene(job.spec.scene));
-      if (!job.spec.masks.empty()) loaded->masks = io::mask_store(job.spec.masks, *loaded);
-      scene = std::move(loaded);
-    }
+    const std::shared_ptr<const Scene> scene =
+        job.spec.scene_data ? job.spec.scene_data
+                            : std::make_shared<const Scene>(io::load_scene(job.spec.scene, {.mask_folder = job.spec.masks}));
     std::shared_ptr<const Mesh> initial = job.spec.mesh_data;
     if (!initial) {
       std::filesystem::path mesh_file = job.spec.mesh;

@@ -27,7 +27,6 @@
 #include "engine/model/error.h"
 #include "engine/refine/refiner.h"
 #include "engine/worker/worker.h"
-#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
 #include "stages/eval/evaluation.h"
@@ -195,8 +194,7 @@ py::dict refine(const fs::path& scene_path, const py::object& mesh, const std::s
   RefineResult result;
   {
     py::gil_scoped_release release;
-    Scene scene = io::load_scene(scene_path);
-    if (mask_folder) scene.masks = io::mask_store(*mask_folder, scene);
+    const Scene scene = io::load_scene(scene_path, {.mask_folder = mask_folder.value_or(fs::path())});
     Mesh initial;
     if (given) {
       initial = build_mesh(*given, "mesh argument");
