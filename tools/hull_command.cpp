@@ -23,23 +23,16 @@
 #include "stages/flow/silhouette.h"
 #include "stages/flow/silhouette_holes.h"
 #include "tools/commands.h"
+#include "tools/hull_options.h"
 
 namespace mvflow::cli {
 
 namespace {
 
-struct HullArguments {
-  std::string scene;
+struct HullCommand {
+  HullArguments carving;
   std::string output;
-  std::string masks;
-  std::string save_masks;
-  SilhouetteOptions silhouette;
-  double fill_holes = 0.005;  // enclosed background regions up to this fraction of the image are filled
-  std::vector<double> bbox;
-  HullMeshOptions options;
-  int threads = 0;
   bool ascii = false;
-  std::vector<int> excluded_views;  // held out: neither their silhouettes nor their images are read
 };
 
 // The views the hull is carved from: every view but the excluded ones, in scene order.
@@ -108,11 +101,10 @@ void save_masks(const std::filesystem::path& folder, const Scene& scene, const s
                   mask_image(masks[k]));
 }
 
-int run_hull(const HullArguments& args, spdlog::logger& log) {
-  io::mesh_format_from_path(args.output);  // a bad extension fails now, not after the carving
-  io::check_writable(args.output);        // ... and so does an output that could not be saved
+}  // namespace
+
+CarvedHull carve_hull(const HullArguments& args, spdlog::logger& log) {
   if (!args.save_masks.empty()) io::prepare_output_folder(args.save_masks);
-  const auto start = std::chrono::steady_clock::now();
   const Scene scene = io::load_scene(args.scene);
   const BoundingBox box = bounding_box(args, scene, log);
   const std::vector<std::size_t> used = used_views(args, scene);
@@ -121,18 +113,31 @@ int run_hull(const HullArguments& args, spdlog::logger& log) {
   std::vector<Camera> cameras;
   for (const std::size_t i : used) cameras.push_back(scene.views[i].camera);
 
-  HullMeshResult hull;
+  CarvedHull carved;
+  carved.views = used.size();
   tbb::task_arena arena(args.threads > 0 ? args.threads : tbb::task_arena::automatic);
-  parallel::execute(arena, [&] { hull = make_hull_mesh(cameras, masks, box, args.options); });
+  parallel::execute(arena, [&] { carved.hull = make_hull_mesh(cameras, masks, box, args.options); });
+  return carved;
+}
+
+namespace {
+
+int run_hull(const HullCommand& command, spdlog::logger& log) {
+  const HullArguments& args = command.carving;
+  io::mesh_format_from_path(command.output);  // a bad extension fails now, not after the carving
+  io::check_writable(command.output);        // ... and so does an output that could not be saved
+  const auto start = std::chrono::steady_clock::now();
+  const CarvedHull carved = carve_hull(args, log);
+  const HullMeshResult& hull = carved.hull;
 
   io::MeshWriteOptions write_options;
-  write_options.binary = !args.ascii;
-  io::write_mesh(args.output, hull.mesh, write_options);
+  write_options.binary = !command.ascii;
+  io::write_mesh(command.output, hull.mesh, write_options);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  const Mesh mesh = build_mesh(hull.mesh, args.output);
+  const Mesh mesh = build_mesh(hull.mesh, command.output);
   const MeshStats stats = compute_mesh_stats(mesh);
-  fmt::print("silhouettes {} views, {}", used.size(),
+  fmt::print("silhouettes {} views, {}", carved.views,
              args.masks.empty() ? fmt::format("threshold {}", args.silhouette.threshold)
                                 : fmt::format("mask files from {}", args.masks));
   fmt::print(", dilated by {} px, holes up to {} % of the image filled\n", args.silhouette.dilate, 100 * args.fill_holes);
@@ -151,78 +156,82 @@ int run_hull(const HullArguments& args, spdlog::logger& log) {
   fmt::print("edges       shortest {:.4g}, mean {:.4g}, longest {:.4g} (shortest/mean {:.2f})\n", stats.shortest_edge,
              stats.mean_edge, stats.longest_edge, stats.shortest_edge / stats.mean_edge);
   fmt::print("volume      {:.6g}\n", enclosed_volume(hull.mesh));
-  log.info("wrote {} in {:.2f} s", args.output, seconds);
+  log.info("wrote {} in {:.2f} s", command.output, seconds);
   return kOk;
 }
 
 }  // namespace
 
+void add_hull_options(CLI::App& command, HullArguments& args) {
+  CLI::Option* masks = command.add_option(
+      "--masks", args.masks,
+      "Folder of mask images, one per view, matched by file-name stem (non-zero = object); default: threshold the "
+      "photographs");
+  command.add_option("--save-masks", args.save_masks,
+                "Also write the silhouettes used (after dilation and hole filling) as PNGs into this folder, named like the views' "
+                "images, so they can be checked, edited and passed to --masks");
+  command.add_option("--threshold", args.silhouette.threshold,
+                "A pixel is object when its largest channel exceeds this (on [0,1]); 0.19 suits the Middlebury "
+                "black backgrounds")
+      ->check(CLI::Range(0.0, 0.999999))
+      ->capture_default_str()
+      ->excludes(masks);
+  command.add_option("--dilate", args.silhouette.dilate,
+                "Dilate every silhouette by a disc of this radius in pixels, for a conservative hull (Middlebury: 10)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  command.add_option("--fill-holes", args.fill_holes,
+                "Fill background regions enclosed by the silhouette (shadows that the threshold missed) up to this "
+                "fraction of the image area, after the dilation; larger ones are taken as see-through openings")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  command.add_option("--bbox", args.bbox, "MINX MINY MINZ MAXX MAXY MAXZ: carve inside this box (default: the scene's)")
+      ->expected(6);
+  command.add_option("--resolution", args.options.carving.resolution, "Grid samples along the box's longest side")
+      ->check(CLI::Range(8, 1024))
+      ->capture_default_str();
+  command.add_option("--min-views", args.options.carving.min_views,
+                "A point seen by fewer views (in front of the camera, inside the image) is carved away")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  command.add_option("--smoothing", args.options.smoothing,
+                "Gaussian blur of the carved field, sigma in grid samples: rounds the hull's creases off and removes "
+                "tunnels and bridges thinner than a voxel")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  command.add_option("--vertices", args.options.vertices, "Target vertex count of the mesh")
+      ->check(CLI::Range(20, 10000000))
+      ->capture_default_str();
+  command.add_option("--neck-edge", args.options.neck_edge,
+                "Cut the mesh along loops of three edges around necks and handles thinner than the mesh, where an "
+                "edge stays shorter than this fraction of the target length (0 = never cut)")
+      ->check(CLI::Range(0.0, 0.8))
+      ->capture_default_str();
+  command.add_option("--remesh-iterations", args.options.remeshing_iterations, "Rounds of isotropic remeshing")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  command.add_option("--threads", args.threads, "Worker threads (0 = all cores; the mesh does not depend on it)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command.add_option("--exclude-views", args.excluded_views,
+                "0-based views not to carve with (held out: their photographs are never read)")
+      ->delimiter(',');
+}
+
 void add_hull_command(CLI::App& app, Runner& runner) {
-  auto args = std::make_shared<HullArguments>();
+  auto command = std::make_shared<HullCommand>();
   CLI::App* c = app.add_subcommand(
       "hull",
       "Initial mesh from silhouettes: the visual hull carved on a grid inside the bounding box, its surface "
       "extracted (marching tetrahedra on a signed distance to the silhouette outlines), the largest piece "
       "remeshed isotropically to about --vertices vertices with edges of nearly one length, necks thinner than "
       "the mesh cut; closed, manifold, outward normals");
-  c->add_option("scene", args->scene, "Scene folder, or a camera file inside one")->required();
-  c->add_option("-o,--output", args->output, "Mesh to write; format from the extension, written atomically")
+  c->add_option("scene", command->carving.scene, "Scene folder, or a camera file inside one")->required();
+  c->add_option("-o,--output", command->output, "Mesh to write; format from the extension, written atomically")
       ->required();
-  CLI::Option* masks = c->add_option(
-      "--masks", args->masks,
-      "Folder of mask images, one per view, matched by file-name stem (non-zero = object); default: threshold the "
-      "photographs");
-  c->add_option("--save-masks", args->save_masks,
-                "Also write the silhouettes used (after dilation and hole filling) as PNGs into this folder, named like the views' "
-                "images, so they can be checked, edited and passed to --masks");
-  c->add_option("--threshold", args->silhouette.threshold,
-                "A pixel is object when its largest channel exceeds this (on [0,1]); 0.19 suits the Middlebury "
-                "black backgrounds")
-      ->check(CLI::Range(0.0, 0.999999))
-      ->capture_default_str()
-      ->excludes(masks);
-  c->add_option("--dilate", args->silhouette.dilate,
-                "Dilate every silhouette by a disc of this radius in pixels, for a conservative hull (Middlebury: 10)")
-      ->check(CLI::Range(0, 1000))
-      ->capture_default_str();
-  c->add_option("--fill-holes", args->fill_holes,
-                "Fill background regions enclosed by the silhouette (shadows that the threshold missed) up to this "
-                "fraction of the image area, after the dilation; larger ones are taken as see-through openings")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  c->add_option("--bbox", args->bbox, "MINX MINY MINZ MAXX MAXY MAXZ: carve inside this box (default: the scene's)")
-      ->expected(6);
-  c->add_option("--resolution", args->options.carving.resolution, "Grid samples along the box's longest side")
-      ->check(CLI::Range(8, 1024))
-      ->capture_default_str();
-  c->add_option("--min-views", args->options.carving.min_views,
-                "A point seen by fewer views (in front of the camera, inside the image) is carved away")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  c->add_option("--smoothing", args->options.smoothing,
-                "Gaussian blur of the carved field, sigma in grid samples: rounds the hull's creases off and removes "
-                "tunnels and bridges thinner than a voxel")
-      ->check(CLI::Range(0.0, 100.0))
-      ->capture_default_str();
-  c->add_option("--vertices", args->options.vertices, "Target vertex count of the mesh")
-      ->check(CLI::Range(20, 10000000))
-      ->capture_default_str();
-  c->add_option("--neck-edge", args->options.neck_edge,
-                "Cut the mesh along loops of three edges around necks and handles thinner than the mesh, where an "
-                "edge stays shorter than this fraction of the target length (0 = never cut)")
-      ->check(CLI::Range(0.0, 0.8))
-      ->capture_default_str();
-  c->add_option("--remesh-iterations", args->options.remeshing_iterations, "Rounds of isotropic remeshing")
-      ->check(CLI::Range(2, 1000))
-      ->capture_default_str();
-  c->add_option("--threads", args->threads, "Worker threads (0 = all cores; the mesh does not depend on it)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  c->add_option("--exclude-views", args->excluded_views,
-                "0-based views not to carve with (held out: their photographs are never read)")
-      ->delimiter(',');
-  c->add_flag("--ascii", args->ascii, "Write PLY/STL as ASCII instead of binary");
-  c->callback([args, &runner] { runner = [args](spdlog::logger& log) { return run_hull(*args, log); }; });
+  add_hull_options(*c, command->carving);
+  c->add_flag("--ascii", command->ascii, "Write PLY/STL as ASCII instead of binary");
+  c->callback([command, &runner] { runner = [command](spdlog::logger& log) { return run_hull(*command, log); }; });
 }
 
 }  // namespace mvflow::cli

@@ -113,9 +113,10 @@ def test_refine_options_are_checked(scene):
         mvflow.refine(scene / "missing")
 
 
-def test_hull_is_closed_and_inside_the_box(scene):
+def test_hull_is_closed_and_inside_the_box(scene, capfd):
     vertices, faces = mvflow.hull(scene, resolution=48, vertices=400)
     assert len(vertices) > 100 and faces.shape[1] == 3
+    assert capfd.readouterr().out == ""  # a library call prints nothing (the program's report is its own)
     # Closed: every edge is shared by exactly two faces.
     edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
     _, counts = np.unique(edges, axis=0, return_counts=True)

@@ -14,15 +14,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
 
 #include "engine/model/error.h"
 #include "engine/refine/refiner.h"
@@ -31,7 +28,7 @@
 #include "io/scene_io.h"
 #include "stages/eval/evaluation.h"
 #include "stages/flow/photo_kernel.h"
-#include "tools/commands.h"
+#include "tools/hull_options.h"
 #include "tools/refine_option_table.h"
 
 #ifndef MVFLOW_VERSION
@@ -211,32 +208,18 @@ py::dict refine(const fs::path& scene_path, const py::object& mesh, const std::s
   return result_dict(result.summary, result.mesh);
 }
 
-//! `mvflow hull` in-process, into a temporary folder; the carved mesh as arrays.
+//! `mvflow hull`'s carving in-process (the same options, nothing printed, no file); the mesh as arrays.
 py::tuple hull(const fs::path& scene_path, int threads, const py::kwargs& kwargs) {
-  static std::atomic<int> counter{0};
-  const fs::path folder = fs::temp_directory_path() / ("mvflow-python-hull-" + std::to_string(::getpid()) + "-" +
-                                                       std::to_string(counter++));
-  fs::create_directories(folder);
-  struct Cleanup {
-    fs::path folder;
-    ~Cleanup() {
-      std::error_code ignored;
-      fs::remove_all(folder, ignored);
-    }
-  } cleanup{folder};
-  const fs::path output = folder / "hull.ply";
-  std::vector<std::string> args{"hull", scene_path.string(), "-o", output.string(), "--threads", std::to_string(threads)};
-  const std::vector<std::string> extra = flags_of(kwargs);
-  args.insert(args.end(), extra.begin(), extra.end());
+  cli::HullArguments args;
   CLI::App app;
-  cli::Runner runner;
-  cli::add_all_commands(app, runner);
-  parse(app, args, "hull options");
+  cli::add_hull_options(app, args);
+  parse(app, flags_of(kwargs), "hull options");
+  args.scene = scene_path.string();
+  args.threads = threads;
   IndexedMesh mesh;
   {
     py::gil_scoped_release release;
-    if (runner(*warnings_logger()) != cli::kOk) throw Error("mvflow hull failed for " + scene_path.string());
-    mesh = io::read_mesh(output);
+    mesh = cli::carve_hull(args, *warnings_logger()).hull.mesh;
   }
   return arrays_from_indexed(mesh);
 }
