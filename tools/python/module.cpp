@@ -115,7 +115,10 @@ std::vector<std::string> flags_of(const py::kwargs& kwargs) {
     if (py::isinstance<py::bool_>(value)) {
       text = value.cast<bool>() ? "on" : "off";
     } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
-      for (const auto& item : value.cast<py::sequence>()) text += (text.empty() ? "" : ",") + py::str(item).cast<std::string>();
+      for (const auto& item : value.cast<py::sequence>()) {
+        if (!text.empty()) text += ',';
+        text += py::str(item).cast<std::string>();
+      }
     } else {
       text = py::str(value).cast<std::string>();
     }
