@@ -62,14 +62,13 @@ std::vector<PhotoView> usable_views(const Scene& scene, const std::vector<int>& 
     if (view >= static_cast<int>(scene.size()))
       refuse("excluded view " + std::to_string(view) + " does not exist (the scene has " +
              std::to_string(scene.size()) + " views)");
-  std::size_t left = 0;
-  for (std::size_t i = 0; i < scene.size(); ++i)
-    if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) == excluded.end()) ++left;
-  if (left < 2) refuse("fewer than 2 views are left to refine with (" + std::to_string(scene.size()) + " views, " +
-                       std::to_string(scene.size() - left) + " excluded)");
+  const std::vector<std::size_t> kept_indices = kept_view_indices(scene, excluded);
+  if (kept_indices.size() < 2)
+    refuse("fewer than 2 views are left to refine with (" + std::to_string(scene.size()) + " views, " +
+           std::to_string(scene.size() - kept_indices.size()) + " excluded)");
   std::vector<PhotoView> all = make_photo_views(scene);
   std::vector<PhotoView> kept;
-  for (std::size_t i : kept_view_indices(scene, excluded)) kept.push_back(all[i]);
+  for (std::size_t i : kept_indices) kept.push_back(all[i]);
   return kept;
 }
 
