@@ -20,7 +20,7 @@
 namespace mvflow::detail {
 
 namespace baseline {
-constexpr int kLanes = 2;  // SSE2: two doubles per xmm register
+constexpr int kLanes = 2;  // two doubles per register: SSE2 on x86-64, the portable vectors elsewhere (arm64)
 #include "stages/flow/photo_kernel_body.inc"
 }  // namespace baseline
 
