@@ -168,21 +168,21 @@ void add_hull_options(CLI::App& command, HullArguments& args) {
       "Folder of mask images, one per view, matched by file-name stem (non-zero = object); default: threshold the "
       "photographs");
   command.add_option("--save-masks", args.save_masks,
-                "Also write the silhouettes used (after dilation and hole filling) as PNGs into this folder, named like the views' "
-                "images, so they can be checked, edited and passed to --masks");
+                     "Also write the silhouettes used (after dilation and hole filling) as PNGs into this folder, named like the views' "
+                     "images, so they can be checked, edited and passed to --masks");
   command.add_option("--threshold", args.silhouette.threshold,
-                "A pixel is object when its largest channel exceeds this (on [0,1]); 0.19 suits the Middlebury "
-                "black backgrounds")
+                     "A pixel is object when its largest channel exceeds this (on [0,1]); 0.19 suits the Middlebury "
+                     "black backgrounds")
       ->check(CLI::Range(0.0, 0.999999))
       ->capture_default_str()
       ->excludes(masks);
   command.add_option("--dilate", args.silhouette.dilate,
-                "Dilate every silhouette by a disc of this radius in pixels, for a conservative hull (Middlebury: 10)")
+                     "Dilate every silhouette by a disc of this radius in pixels, for a conservative hull (Middlebury: 10)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   command.add_option("--fill-holes", args.fill_holes,
-                "Fill background regions enclosed by the silhouette (shadows that the threshold missed) up to this "
-                "fraction of the image area, after the dilation; larger ones are taken as see-through openings")
+                     "Fill background regions enclosed by the silhouette (shadows that the threshold missed) up to this "
+                     "fraction of the image area, after the dilation; larger ones are taken as see-through openings")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   command.add_option("--bbox", args.bbox, "MINX MINY MINZ MAXX MAXY MAXZ: carve inside this box (default: the scene's)")
@@ -191,20 +191,20 @@ void add_hull_options(CLI::App& command, HullArguments& args) {
       ->check(CLI::Range(8, 1024))
       ->capture_default_str();
   command.add_option("--min-views", args.options.carving.min_views,
-                "A point seen by fewer views (in front of the camera, inside the image) is carved away")
+                     "A point seen by fewer views (in front of the camera, inside the image) is carved away")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   command.add_option("--smoothing", args.options.smoothing,
-                "Gaussian blur of the carved field, sigma in grid samples: rounds the hull's creases off and removes "
-                "tunnels and bridges thinner than a voxel")
+                     "Gaussian blur of the carved field, sigma in grid samples: rounds the hull's creases off and removes "
+                     "tunnels and bridges thinner than a voxel")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   command.add_option("--vertices", args.options.vertices, "Target vertex count of the mesh")
       ->check(CLI::Range(20, 10000000))
       ->capture_default_str();
   command.add_option("--neck-edge", args.options.neck_edge,
-                "Cut the mesh along loops of three edges around necks and handles thinner than the mesh, where an "
-                "edge stays shorter than this fraction of the target length (0 = never cut)")
+                     "Cut the mesh along loops of three edges around necks and handles thinner than the mesh, where an "
+                     "edge stays shorter than this fraction of the target length (0 = never cut)")
       ->check(CLI::Range(0.0, 0.8))
       ->capture_default_str();
   command.add_option("--remesh-iterations", args.options.remeshing_iterations, "Rounds of isotropic remeshing")
@@ -214,7 +214,7 @@ void add_hull_options(CLI::App& command, HullArguments& args) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command.add_option("--exclude-views", args.excluded_views,
-                "0-based views not to carve with (held out: their photographs are never read)")
+                     "0-based views not to carve with (held out: their photographs are never read)")
       ->delimiter(',');
 }
 
