@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -12,6 +13,17 @@
 namespace mvflow {
 
 namespace {
+
+// A build of the photo kernel forced with MVFLOW_KERNEL caps Embree's instruction set too, so
+// that the forced build runs as on a machine that has only that set (README, "Performance").
+std::string embree_config() {
+  const char* forced = std::getenv("MVFLOW_KERNEL");
+  if (forced == nullptr) return {};
+  const std::string build(forced);
+  if (build == "baseline") return "max_isa=sse2";
+  if (build == "avx2") return "max_isa=avx2";
+  return {};
+}
 
 // Embree reports errors through a callback; we keep the last message and throw from the caller.
 struct DeviceErrors {
@@ -80,7 +92,8 @@ SurfaceQuery::SurfaceQuery(const std::vector<Eigen::Vector3d>& positions,
   for (const auto& t : triangles_)
     for (auto v : t) MVFLOW_CHECK(v < positions_.size(), "triangle index out of range");
   Embree& e = *embree_;
-  e.device = rtcNewDevice(nullptr);
+  const std::string config = embree_config();
+  e.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
   if (!e.device) throw Error("Embree: cannot create a device (unsupported CPU?)");
   rtcSetDeviceErrorFunction(e.device, on_embree_error, &e.errors);
   e.scene = rtcNewScene(e.device);
