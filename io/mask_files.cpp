@@ -29,6 +29,8 @@ std::string describe(const View& view, std::size_t index) {
 
 }  // namespace
 
+fs::path mask_file_name(const View& view) { return fs::path(view.image_name).stem().string() + ".png"; }
+
 fs::path find_mask_file(const fs::path& folder, const View& view, std::size_t index) {
   if (!fs::is_directory(folder)) throw IoError(folder, "the mask folder does not exist or is not a folder");
   const fs::path stem = fs::path(view.image_name).stem();
@@ -38,7 +40,7 @@ fs::path find_mask_file(const fs::path& folder, const View& view, std::size_t in
       candidates.push_back(entry.path());
   std::sort(candidates.begin(), candidates.end());
   if (candidates.empty())
-    throw InputError(folder / (stem.string() + ".png"), 0,
+    throw InputError(folder / mask_file_name(view), 0,
                      "no mask for " + describe(view, index) + "; expected an image named " + stem.string() +
                          " with an image extension (.png, .pgm, .jpg, .tif, ...) in the mask folder");
   if (candidates.size() > 1) {

@@ -14,6 +14,10 @@
 
 namespace mvflow::io {
 
+//! The name a mask file of \p view is written under: the stem of view.image_name with .png (what
+//! find_mask_file finds; `hull --save-masks` and `synth --masks` write it).
+std::filesystem::path mask_file_name(const View& view);
+
 //! The mask file of \p view (the \p index-th view of its scene) in \p folder: the one file whose
 //! stem is the stem of view.image_name and whose extension is an image format (png, pgm, ppm,
 //! pbm, bmp, jpg, jpeg, tif, tiff; any case).

@@ -97,8 +97,7 @@ void save_masks(const std::filesystem::path& folder, const Scene& scene, const s
                 const std::vector<Mask>& masks) {
   std::filesystem::create_directories(folder);
   for (std::size_t k = 0; k < masks.size(); ++k)
-    io::write_png(folder / (std::filesystem::path(scene.views[used[k]].image_name).stem().string() + ".png"),
-                  mask_image(masks[k]));
+    io::write_png(folder / io::mask_file_name(scene.views[used[k]]), mask_image(masks[k]));
 }
 
 }  // namespace

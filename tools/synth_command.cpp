@@ -17,6 +17,7 @@
 #include "io/atomic_write.h"
 #include "io/camera_io.h"
 #include "io/image_io.h"
+#include "io/mask_files.h"
 #include "io/mesh_io.h"
 #include "io/number_text.h"
 #include "stages/synth/synth_scene.h"
@@ -339,8 +340,7 @@ void write_scene(const fs::path& folder, const SynthScene& scene, const Settings
   for (std::size_t i = 0; i < scene.views.size(); ++i) io::write_png(folder / scene.views[i].image_name, scene.images[i]);
   if (!scene.silhouettes.empty()) fs::create_directories(folder / "masks");
   for (std::size_t i = 0; i < scene.silhouettes.size(); ++i)
-    io::write_png(folder / "masks" / (fs::path(scene.views[i].image_name).stem().string() + ".png"),
-                  mask_image(scene.silhouettes[i]));
+    io::write_png(folder / "masks" / io::mask_file_name(scene.views[i]), mask_image(scene.silhouettes[i]));
   if (s.cameras == "colmap") io::write_colmap(folder, scene.views);
   else io::write_middlebury(folder / "synth_par.txt", scene.views);
   io::write_mesh(folder / "truth.ply", scene.truth);

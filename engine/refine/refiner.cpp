@@ -425,10 +425,10 @@ class Refinement {
   double reference_edge_ = 0.0;
   double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
   std::size_t untangled_pairs_ = 0;
-  // Where each vertex was when the flow started (UnobservedDisplacementOptions), midpoints for the
-  // vertices refinement added; empty when the option is off.
   bool rims_from_masks_ = false;  //!< the silhouettes are the scene's mask images (Scene::masks)
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
+  // Where each vertex was when the flow started (UnobservedDisplacementOptions), midpoints for the
+  // vertices refinement added; empty when the option is off.
   std::vector<Eigen::Vector3d> reference_;
   std::unique_ptr<IterationGraph> graph_;  //!< rebuilt when the topology changes
   std::optional<SilhouetteConstraint> inside_;
