@@ -38,7 +38,8 @@ constexpr int kLanes = 4;  // four doubles per ymm register
 #pragma GCC push_options
 #pragma GCC target("arch=x86-64-v4")
 #pragma GCC diagnostic push
-// GCC 12's _mm512_cvtps_pd starts from _mm512_undefined_pd() and warns about it.
+// GCC 12's AVX-512 intrinsics start from _mm512_undefined_ps() and warn about it, and it does not
+// see that PatchSums' rows are written by the first patch added (views == 0) before any read.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #define MVFLOW_KERNEL_AVX512
 namespace avx512 {

@@ -3,8 +3,9 @@
 // same source (x86-64 baseline, AVX2, AVX-512; the baseline alone on other processors), one of
 // them chosen once, on first use, by active_photo_kernel(): the one named by the environment
 // variable MVFLOW_KERNEL (baseline, avx2 or avx512), else the widest one the CPU runs. Every build gives the same bits: each patch value is
-// interpolated by the same float operations and summed by the same double operations in the
-// same order (no FMA contraction); only the lane width differs. Callers use photo_consistency()
+// interpolated, shifted by the first view's value and summed over the views by the same float
+// operations in the same order (no FMA contraction; SPEC §3's float sums on shifted data), and
+// the values' totals are summed in one fixed order; only the lane width differs. Callers use photo_consistency()
 // and PhotoGradientStage.
 
 #include <Eigen/Core>
