@@ -9,6 +9,7 @@
 #include "engine/model/camera.h"
 #include "engine/model/image.h"
 #include "stages/flow/photo_consistency.h"
+#include "stages/flow/photo_gradient.h"
 
 namespace mvflow::test {
 
@@ -21,7 +22,8 @@ inline std::vector<const Image*> pointers(const std::vector<Image>& images) {
 // The slow reference: every sample bilinear-interpolated on its own in double, variances by the
 // two-pass formula (mean first), straight from SPEC §3; patch (2h+1)².
 inline PhotoValue slow_photo_consistency(const Eigen::Vector3d& X, const std::vector<Camera>& cameras,
-                                  const std::vector<Image>& images, const std::vector<std::uint16_t>& ids, int h = 2) {
+                                         const std::vector<Image>& images, const std::vector<std::uint16_t>& ids,
+                                         int h = 2) {
   std::vector<std::vector<double>> patches;  // per usable view: 3·(2h+1)² values
   for (auto id : ids) {
     const Projection p = cameras[id].project(X);
@@ -54,6 +56,23 @@ inline PhotoValue slow_photo_consistency(const Eigen::Vector3d& X, const std::ve
   }
   result.g = g;
   return result;
+}
+
+//! ∇g at \p X by \p stage's Savitzky–Golay sum over the slow reference at its samples, spaced \p dx.
+inline Eigen::Vector3d slow_photo_gradient(const PhotoGradientStage& stage, const Eigen::Vector3d& X, double dx,
+                                           const std::vector<Camera>& cameras, const std::vector<Image>& images,
+                                           const std::vector<std::uint16_t>& ids) {
+  Eigen::Vector3d gradient;
+  for (int axis = 0; axis < 3; ++axis) {
+    double derivative = 0;
+    for (int k = -10; k <= 10; ++k) {
+      Eigen::Vector3d sample = X;
+      sample[axis] += k * dx;
+      derivative += stage.coefficients()[k + 10] * slow_photo_consistency(sample, cameras, images, ids).g;
+    }
+    gradient[axis] = derivative / dx;
+  }
+  return gradient;
 }
 
 }  // namespace mvflow::test

@@ -14,7 +14,6 @@
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
 #include "photo_reference.h"
-#include "stages/flow/photo_gradient.h"
 #include "stages/flow/photo_views.h"
 #include "test_support.h"
 
@@ -132,16 +131,7 @@ void expect_reference_accuracy_on_photographs(const std::string& set) {
     std::copy(facing.begin(), facing.end(), fields.visible_views.begin());
     stage.run(probe.topology, {0, 1}, views, dx, fields);
     if (!(fields.defined[0] & kGradientDefined)) continue;
-    Eigen::Vector3d expected;
-    for (int axis = 0; axis < 3; ++axis) {
-      double derivative = 0;
-      for (int k = -10; k <= 10; ++k) {
-        Eigen::Vector3d X = P;
-        X[axis] += k * dx;
-        derivative += stage.coefficients()[k + 10] * test::slow_photo_consistency(X, cameras, images, facing).g;
-      }
-      expected[axis] = derivative / dx;
-    }
+    const Eigen::Vector3d expected = test::slow_photo_gradient(stage, P, dx, cameras, images, facing);
     ++gradients;
     const double error = (fields.photo_gradient[0] - expected).norm() / expected.norm();
     EXPECT_LT(error, 1e-4) << set << " vertex " << v;

@@ -553,16 +553,8 @@ TEST(PhotoGradient, MatchesTheSlowReferenceOnARenderedObject) {
     if (!(fields.defined[p] & kGradientDefined)) continue;
     const std::span<const std::uint16_t> visible_span = fields.visible(p);
     const std::vector<std::uint16_t> visible(visible_span.begin(), visible_span.end());
-    Eigen::Vector3d expected;
-    for (int axis = 0; axis < 3; ++axis) {
-      double derivative = 0;
-      for (int k = -10; k <= 10; ++k) {
-        Eigen::Vector3d X = probes.position(p);
-        X[axis] += k * dx;
-        derivative += stage.coefficients()[k + 10] * slow_photo_consistency(X, s.cameras, s.images, visible).g;
-      }
-      expected[axis] = derivative / dx;
-    }
+    const Eigen::Vector3d expected =
+        test::slow_photo_gradient(stage, probes.position(p), dx, s.cameras, s.images, visible);
     ++compared;
     const double error = (fields.photo_gradient[p] - expected).norm() / expected.norm();
     EXPECT_LT(error, 1e-5) << "probe " << p;
