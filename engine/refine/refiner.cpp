@@ -331,9 +331,12 @@ class Refinement {
   // Normals and curvature at the current positions for every vertex (after the untangling moved
   // some), for the adaptive refinement's marks.
   void update_curvature() {
-    const IndexRange all{0, static_cast<std::uint32_t>(mesh_.n_vertices())};
-    compute_normals(mesh_, all, data_.fields);
-    compute_mean_curvature(mesh_, all, data_.fields, options_.curvature);
+    // Per block in parallel: a vertex's curvature reads its own normal only.
+    const std::vector<IndexRange> blocks = split_into_blocks(mesh_.n_vertices(), options_.block_size);
+    parallel::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+      compute_normals(mesh_, blocks[b], data_.fields);
+      compute_mean_curvature(mesh_, blocks[b], data_.fields, options_.curvature);
+    });
   }
 
   // Adaptive refinement from the curvature of the last iteration (SPEC §5). True when the
