@@ -38,6 +38,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--spread-unobserved", {"on", "on"}},
       {"--observed-view-angle", {"60", 60.0}},
       {"--observed-erode", {"2", 2}},
+      {"--hardly-observed", {"0.4", 0.4}},
       {"--fill-unobserved", {"on", true}},
       {"--weak-view-angle", {"60", 60.0}},
       {"--fit-silhouettes", {"on", "on"}},
@@ -118,7 +119,7 @@ TEST(RefineOptionTable, EachFlagSetsItsOwnFieldAndNothingElse) {
 TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
-        {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}}) {
+        {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"}}) {
     EXPECT_THROW(options_after(bad), CLI::ParseError) << bad[0] << " " << bad[1];
   }
 }

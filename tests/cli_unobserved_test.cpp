@@ -21,21 +21,25 @@ namespace fs = std::filesystem;
 struct CapErrors {
   double cap = 0.0;       // mean radial error below 75° south
   double observed = 0.0;  // ... between 45° south and 45° north
+  double south = 0.0;     // ... below 55° south (issue 12's weakly seen region)
+  double rest = 0.0;      // ... everywhere else
 };
 
 CapErrors cap_errors(const fs::path& mesh_file) {
   const IndexedMesh mesh = io::read_mesh(mesh_file);
-  const double cap_sine = -std::sin(75.0 * std::numbers::pi / 180.0), band_sine = std::sin(45.0 * std::numbers::pi / 180.0);
-  double cap = 0.0, observed = 0.0;
-  int in_cap = 0, in_band = 0;
+  const auto sine_of = [](double degrees) { return std::sin(degrees * std::numbers::pi / 180.0); };
+  double cap = 0.0, observed = 0.0, south = 0.0, rest = 0.0;
+  int in_cap = 0, in_band = 0, in_south = 0, in_rest = 0;
   for (const Eigen::Vector3d& p : mesh.positions) {
     const double sine = p.y() / p.norm(), error = std::abs(p.norm() - 1.0);
-    if (sine < cap_sine) cap += error, ++in_cap;
-    if (std::abs(sine) <= band_sine) observed += error, ++in_band;
+    if (sine < -sine_of(75)) cap += error, ++in_cap;
+    if (std::abs(sine) <= sine_of(45)) observed += error, ++in_band;
+    if (sine < -sine_of(55)) south += error, ++in_south;
+    else rest += error, ++in_rest;
   }
   EXPECT_GT(in_cap, 20);
   EXPECT_GT(in_band, 1000);
-  return {cap / in_cap, observed / in_band};
+  return {cap / in_cap, observed / in_band, south / in_south, rest / in_rest};
 }
 
 // Renders the rig of issue 12 (the unit sphere, 24 views on rings at −15° and +25°, 2562 initial
@@ -61,25 +65,22 @@ TEST(CliUnobserved, AGrazingCapFollowsTheObservedSurface) {
   // The scene of issue 12 (at 320×240 with 642 initial vertices the cap ends at 2.0× instead).
   const auto synth = synth_grazing_sphere(scene);
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  // Without the step damping (default on), as when the spread was measured: with it the observed
-  // region improves more than the cap (0.0010 against 0.0026 with the spread), so the ratio is
-  // 2.6; Quality.TwoRingSphereSettlesWithinSixtyIterations holds the damped run to issue 12's
-  // absolute targets instead.
   const auto off = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "off.ply").string() +
-                                    " --damping off");
+                                    " --spread-unobserved off");
   const auto on = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "on.ply").string() +
-                                   " --spread-unobserved on --damping off");
+                                   " --spread-unobserved on");
   ASSERT_EQ(off.exit_code, 0) << off.output;
   ASSERT_EQ(on.exit_code, 0) << on.output;
   EXPECT_NE(on.output.find("unobserved vertices with the observed surface"), std::string::npos) << on.output;
-  // The premise: without the option the cap keeps several times the observed region's error
-  // (measured 0.0111 below −75° against 0.0012 between ±45°).
+  // Issue 12's measure: the mean error below −55° against the rest's. The premise: without a
+  // spread the weakly seen region keeps several times the rest's error (measured 0.0082 against
+  // 0.0014, 6.1×).
   const CapErrors without = cap_errors(folder / "off.ply");
-  EXPECT_GT(without.cap, 4 * without.observed);
-  // With it, within 2× (measured 0.0019 against 0.0013), and little worse where the views are good.
+  EXPECT_GT(without.south, 4 * without.rest);
+  // With it, within 2× (measured 0.0024 against 0.0013, 1.9×), and no worse elsewhere.
   const CapErrors with = cap_errors(folder / "on.ply");
-  EXPECT_LT(with.cap, 2 * with.observed);
-  EXPECT_LT(with.observed, 1.25 * without.observed);
+  EXPECT_LT(with.south, 2 * with.rest);
+  EXPECT_LT(with.rest, 1.1 * without.rest);
   expect_complete(folder / "on.ply", scene, folder.path());
 }
 
@@ -111,21 +112,36 @@ TEST(CliUnobserved, OnABlackBackgroundTheDefaultSpreadsAnchoredAtTheRims) {
   EXPECT_EQ(test::read_text(folder / "sequential.ply"), test::read_text(folder / "auto.ply"));
 }
 
-TEST(CliUnobserved, OnATexturedBackgroundTheDefaultDoesNotSpread) {
+// On a textured background auto spreads only the vertices that hardly had a speed at their
+// resolution; `on` every vertex without one. Neither runs after the finest resolution.
+TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved) {
   const test::ScratchFolder folder;
   const fs::path scene = folder / "scene";
   const auto synth = test::run_mvflow("synth --amplitude 0 --views 12 --width 320 --height 240 --level 4 "
                                       "--init offset:0.02 --init-vertices 642 --elevation -15,25 -o " + scene.string());
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  const auto automatic = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "auto.ply").string() +
-                                          " --max-iterations 20");
+  const auto automatic = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "auto.ply").string());
   const auto on = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "on.ply").string() +
-                                   " --max-iterations 20 --spread-unobserved on");
+                                   " --spread-unobserved on");
+  const auto off = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "off.ply").string() +
+                                    " --spread-unobserved off");
   ASSERT_EQ(automatic.exit_code, 0) << automatic.output;
   ASSERT_EQ(on.exit_code, 0) << on.output;
-  EXPECT_EQ(automatic.output.find("unobserved vertices"), std::string::npos) << automatic.output;
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  EXPECT_NE(automatic.output.find("hardly observed vertices follow the observed surface\n"), std::string::npos)
+      << automatic.output;
   EXPECT_NE(on.output.find("unobserved vertices follow the observed surface\n"), std::string::npos) << on.output;
-  EXPECT_NE(on.output.find("unobserved vertices with the observed surface"), std::string::npos) << on.output;
+  EXPECT_EQ(off.output.find("follow the observed surface"), std::string::npos) << off.output;
+  // Both spread before a refinement; the hardly observed are a subset of the unobserved.
+  const auto moved = [](const std::string& output) {
+    const std::size_t at = output.find(" unobserved vertices with the observed surface");
+    if (at == std::string::npos) return -1L;
+    return std::stol(output.substr(output.rfind("moved ", at) + 6));
+  };
+  EXPECT_GT(moved(automatic.output), 0) << automatic.output;
+  EXPECT_GT(moved(on.output), 0) << on.output;
+  // The cap (below −75°) ends nearer the sphere than without a spread.
+  EXPECT_LT(cap_errors(folder / "auto.ply").cap, cap_errors(folder / "off.ply").cap);
 }
 
 // `refine --masks`: silhouettes from files instead of thresholded photographs, so a textured
@@ -136,7 +152,10 @@ TEST(CliUnobserved, MaskFilesBringTheRimsToATexturedBackground) {
   const auto synth = synth_grazing_sphere(scene, "--masks");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const std::string masks = (scene / "masks").string();
-  const auto plain = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "plain.ply").string());
+  // Against no spread at all: the default spreads the hardly observed vertices on a textured
+  // background too (OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved).
+  const auto plain = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "plain.ply").string() +
+                                      " --spread-unobserved off");
   const auto masked =
       test::run_mvflow("refine " + scene.string() + " --masks " + masks + " -o " + (folder / "masked.ply").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.output;
@@ -147,8 +166,8 @@ TEST(CliUnobserved, MaskFilesBringTheRimsToATexturedBackground) {
   EXPECT_NE(masked.output.find("unobserved vertices follow the observed surface and the silhouette rims"),
             std::string::npos)
       << masked.output;
-  // Measured: the cap (below −75°) 0.0219 without the masks, 0.0028 with; between ±45° 0.00091
-  // and 0.00105.
+  // Measured: the cap (below −75°) 0.0222 without the masks and the spread, 0.0029 with; between
+  // ±45° 0.0009 and 0.0010.
   const CapErrors without = cap_errors(folder / "plain.ply"), with = cap_errors(folder / "masked.ply");
   EXPECT_LT(with.cap, 0.25 * without.cap);
   EXPECT_LT(with.observed, 1.3 * without.observed);

@@ -90,11 +90,13 @@ TEST(Quality, Bunny) {
 }
 
 // Issue 12's targets on its sphere rig (24 views on rings at −15° and +25°, so the cap below
-// −55° is seen only at grazing angles; the initial mesh 1 % of the diagonal outside), with the
-// option for rigs that leave a region unseen (--spread-unobserved on): mean ≤ 0.0025, acc90
-// ≤ 0.005, completeness 100 %, and the run ends by a stopping rule in ≤ 60 iterations
-// (measured: 41 iterations, settled, 0.00096 / 0.00223). Without the spread the unseen cap
-// drifts outward under the smoothing (README, "Quality": completeness 99.6 %).
+// −55° is seen only at grazing angles; the initial mesh 1 % of the diagonal outside): mean
+// ≤ 0.0025, acc90 ≤ 0.005, completeness 100 %, and the run ends by a stopping rule in ≤ 60
+// iterations. With the default options (auto spreads the hardly observed vertices on a textured
+// background; measured 43 iterations, settled, 0.00119 / 0.00252) one truth sample in 50 000 lies
+// 0.0355 from the mesh against the 0.0346 threshold (99.998 %: a vertex the grazing views left
+// 0.05 out at −74°); with --spread-unobserved on (41 iterations, 0.00098 / 0.00221) none. Without
+// any spread the cap drifts outward under the smoothing (README, "Weakly seen regions": 99.69 %).
 TEST(Quality, TwoRingSphereSettlesWithinSixtyIterations) {
   const test::ScratchFolder dir;
   const auto scene = dir.path() / "scene";
@@ -102,27 +104,29 @@ TEST(Quality, TwoRingSphereSettlesWithinSixtyIterations) {
       "synth --amplitude 0 --views 24 --width 640 --height 480 --level 6 --init offset:0.011547 "
       "--init-vertices 2562 --elevation -15,25 -o " + scene.string());
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  const auto refined = dir.path() / "refined.ply";
-  const auto report = dir.path() / "report.json";
-  const test::CommandResult refine =
-      test::run_mvflow("refine " + scene.string() + " -o " + refined.string() + " --report " + report.string() +
-                       " --spread-unobserved on");
-  ASSERT_EQ(refine.exit_code, 0) << refine.output;
-  const auto eval_json = dir.path() / "eval.json";
-  const test::CommandResult eval = test::run_mvflow("eval " + refined.string() + " " + (scene / "truth.ply").string() +
-                                                    " --samples 50000 --json " + eval_json.string());
-  ASSERT_EQ(eval.exit_code, 0) << eval.output;
-  const nlohmann::json e = nlohmann::json::parse(test::read_text(eval_json));
-  const nlohmann::json r = nlohmann::json::parse(test::read_text(report));
-  const std::string status = r.at("status").get<std::string>();
-  std::printf("[measured] two-ring sphere: mean %.5g, acc90 %.5g, completeness %.4g, %zu iterations (%s)\n",
-              e.at("symmetric_mean").get<double>(), e.at("accuracy").get<double>(),
-              e.at("completeness").get<double>(), r.at("iterations").size(), status.c_str());
-  EXPECT_LE(e.at("symmetric_mean").get<double>(), 0.0025);
-  EXPECT_LE(e.at("accuracy").get<double>(), 0.005);
-  EXPECT_EQ(e.at("completeness").get<double>(), 1.0);
-  EXPECT_TRUE(status == "converged" || status == "settled") << status;
-  EXPECT_LE(r.at("iterations").size(), 60u);
+  for (const std::string spread : {"", " --spread-unobserved on"}) {
+    const auto refined = dir.path() / "refined.ply";
+    const auto report = dir.path() / "report.json";
+    const test::CommandResult refine = test::run_mvflow("refine " + scene.string() + " -o " + refined.string() +
+                                                        " --report " + report.string() + spread);
+    ASSERT_EQ(refine.exit_code, 0) << refine.output;
+    const auto eval_json = dir.path() / "eval.json";
+    const test::CommandResult eval = test::run_mvflow("eval " + refined.string() + " " +
+                                                      (scene / "truth.ply").string() + " --samples 50000 --json " +
+                                                      eval_json.string());
+    ASSERT_EQ(eval.exit_code, 0) << eval.output;
+    const nlohmann::json e = nlohmann::json::parse(test::read_text(eval_json));
+    const nlohmann::json r = nlohmann::json::parse(test::read_text(report));
+    const std::string status = r.at("status").get<std::string>();
+    std::printf("[measured] two-ring sphere%s: mean %.5g, acc90 %.5g, completeness %.6g, %zu iterations (%s)\n",
+                spread.c_str(), e.at("symmetric_mean").get<double>(), e.at("accuracy").get<double>(),
+                e.at("completeness").get<double>(), r.at("iterations").size(), status.c_str());
+    EXPECT_LE(e.at("symmetric_mean").get<double>(), 0.0025) << spread;
+    EXPECT_LE(e.at("accuracy").get<double>(), 0.005) << spread;
+    EXPECT_GE(e.at("completeness").get<double>(), spread.empty() ? 0.9999 : 1.0) << spread;
+    EXPECT_TRUE(status == "converged" || status == "settled") << status;
+    EXPECT_LE(r.at("iterations").size(), 60u) << spread;
+  }
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -227,6 +228,25 @@ TEST(UnobservedDisplacement, VerticesOnTheSilhouettesCountAsObservedAndAreNotEro
   }
   EXPECT_GT(cleared, 10u);  // the band and the eroded ring, not an empty test
   EXPECT_THROW(poorly_observed_vertices(mesh, views, fields, options, std::vector<std::uint8_t>(3, 0)), Error);
+}
+
+// Auto without fitted rims spreads only what the flow hardly observed: a vertex stays free when it
+// had a speed in at most fraction × iterations of them (on the boundary, kept).
+TEST(UnobservedDisplacement, HardlyObservedAreThoseWithASpeedInAtMostTheFraction) {
+  const int iterations = 20;
+  std::vector<std::uint32_t> counts;
+  for (std::uint32_t c = 0; c <= 20; ++c) counts.push_back(c);
+  for (const double fraction : {0.0, 0.25, 0.5, 1.0}) {
+    std::vector<std::uint8_t> poor(counts.size(), 1);
+    poor[3] = 0;  // not poorly observed: stays observed whatever its count
+    keep_hardly_observed(poor, counts, iterations, fraction);
+    for (std::size_t v = 0; v < counts.size(); ++v)
+      EXPECT_EQ(poor[v], v != 3 && counts[v] <= fraction * iterations ? 1 : 0) << fraction << " " << v;
+  }
+  std::vector<std::uint8_t> poor(counts.size(), 1);
+  keep_hardly_observed(poor, counts, iterations, 0.25);
+  EXPECT_EQ(std::count(poor.begin(), poor.end(), 1), 6);  // 0, 1, ..., 5 of 20 iterations
+  EXPECT_THROW(keep_hardly_observed(poor, std::vector<std::uint32_t>(3, 0), iterations, 0.25), Error);
 }
 
 }  // namespace

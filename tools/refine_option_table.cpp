@@ -175,8 +175,9 @@ std::vector<RefineOptionEntry> make_table() {
                     [](auto& o) -> auto& { return o.photo.photo.min_views; }));
   t.push_back(choice("--spread-unobserved", "spread_unobserved",
                      "Vertices without g or ∇g take the observed surface's displacement (harmonic, from the surface "
-                     "the flow started on) when the flow converges at a resolution and at the end: on, off, or auto "
-                     "(when the rims are fitted to silhouettes, which then count as observed; thesis preset: off)",
+                     "the flow started on) when the flow converges at a resolution that is then refined: on, off, or "
+                     "auto (all of them when the rims are fitted to silhouettes, which then count as observed, else "
+                     "only the hardly observed ones, --hardly-observed; thesis preset: off)",
                      {{"off", UnobservedSpread::Off}, {"on", UnobservedSpread::On}, {"auto", UnobservedSpread::Auto}},
                      [](auto& o) -> auto& { return o.unobserved_displacement.spread; }));
   t.push_back(value("--observed-view-angle", "observed_view_angle_degrees", "unobserved_displacement.observed_angle_degrees",
@@ -186,6 +187,10 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(value("--observed-erode", "observed_erode_rings", "unobserved_displacement.erode_rings",
                     "--spread-unobserved: shrink the observed set by this many rings before following it",
                     [](auto& o) -> auto& { return o.unobserved_displacement.erode_rings; }));
+  t.push_back(value("--hardly-observed", "hardly_observed_fraction", "unobserved_displacement.hardly_observed_fraction",
+                    "--spread-unobserved auto without fitted rims: only vertices that had a speed in at most this "
+                    "fraction of their resolution's iterations follow the observed surface",
+                    [](auto& o) -> auto& { return o.unobserved_displacement.hardly_observed_fraction; }));
   t.push_back(on_off("--fill-unobserved", "fill_unobserved",
                      "Vertices without g or ∇g move with their observed neighbours (on/off)",
                      [](auto& o) -> auto& { return o.unobserved.fill; }));

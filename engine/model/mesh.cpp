@@ -92,6 +92,13 @@ std::vector<Eigen::Vector3d> positions_of(const TriMesh& mesh) {
   return positions;
 }
 
+void set_positions(TriMesh& mesh, const std::vector<Eigen::Vector3d>& positions) {
+  MVFLOW_CHECK(positions.size() == mesh.n_vertices(), "set_positions: " + std::to_string(positions.size()) +
+                                                          " positions for " + std::to_string(mesh.n_vertices()) +
+                                                          " vertices");
+  for (auto v : mesh.vertices()) mesh.set_point(v, to_openmesh(positions[static_cast<std::size_t>(v.idx())]));
+}
+
 std::vector<std::array<std::uint32_t, 3>> triangles_of(const TriMesh& mesh) {
   std::vector<std::array<std::uint32_t, 3>> triangles;
   triangles.reserve(mesh.n_faces());

@@ -69,6 +69,9 @@ IndexedMesh to_indexed(const Mesh& mesh);
 
 //! Vertex positions of \p mesh, #V, in vertex-id order.
 std::vector<Eigen::Vector3d> positions_of(const TriMesh& mesh);
+//! Moves every vertex of \p mesh to \p positions (positions_of's order).
+//! \throw Error if the count differs from #V.
+void set_positions(TriMesh& mesh, const std::vector<Eigen::Vector3d>& positions);
 //! Triangles of \p mesh, #F, in face-id order, corners in OpenMesh's face-vertex order.
 std::vector<std::array<std::uint32_t, 3>> triangles_of(const TriMesh& mesh);
 

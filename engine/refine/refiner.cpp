@@ -171,7 +171,10 @@ class Refinement {
       data_.rim_views = &full_views_;
     }
     const UnobservedSpread spread = options.unobserved_displacement.spread;
-    spreads_ = spread == UnobservedSpread::On || (spread == UnobservedSpread::Auto && data_.rim_masks);
+    spreads_ = spread != UnobservedSpread::Off;
+    spread_fraction_ = spread == UnobservedSpread::Auto && !data_.rim_masks
+                           ? options.unobserved_displacement.hardly_observed_fraction
+                           : 1.0;
   }
 
   RefineResult run() {
@@ -187,7 +190,8 @@ class Refinement {
       control_.logger->info("fitting the rims to the silhouettes (threshold {}){}", options_.silhouettes.threshold,
                             options_.rims.fit == RimFit::Auto ? ": every view's border is dark" : "");
     if (control_.logger && spreads_)
-      control_.logger->info("unobserved vertices follow the observed surface{}",
+      control_.logger->info("{} follow the observed surface{}",
+                            spread_fraction_ < 1 ? "hardly observed vertices" : "unobserved vertices",
                             data_.rim_masks ? " and the silhouette rims" : "");
     prepare();
     summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, options_).sum_g_per_vertex;
@@ -226,6 +230,7 @@ class Refinement {
         break;
       }
       fill_report(report, edges, refinement_seconds, iteration_start);
+      count_observed();
       StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move, data_.total.defined_g,
                                                    data_.net_move_over_edge);
       report.stop = to_string(reason);
@@ -243,7 +248,10 @@ class Refinement {
     }
 
     progress(static_cast<int>(summary.iterations.size()), RefineStage::Finishing);
-    if (status != RefineStatus::Cancelled) spread_unobserved();
+    // At convergence the spread runs before each refinement (refine_at_convergence); refined every
+    // iteration, once here.
+    if (status != RefineStatus::Cancelled && options_.refinement_schedule == RefinementSchedule::EveryIteration)
+      spread_unobserved();
     const std::optional<UntanglingResult> untangled =
         status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
     summary.untangled_pairs = untangled_pairs_;
@@ -285,6 +293,15 @@ class Refinement {
     apply_smoothing(mesh_, options_.smoothing);
     apply_regularization(mesh_, options_.regularization);
     if (spreads_) reference_ = positions_of(mesh_);
+    if (spreads_) speed_iterations_.assign(mesh_.n_vertices(), 0);
+  }
+
+  // One more iteration at this resolution, and which vertices had a speed in it.
+  void count_observed() {
+    if (!spreads_) return;
+    ++level_iterations_;
+    for (std::size_t v = 0; v < speed_iterations_.size(); ++v)
+      if (data_.fields.defined[v] & kSpeedDefined) ++speed_iterations_[v];
   }
 
   // Removes the folds of the current surface (UntanglingOptions), counted for the summary;
@@ -318,8 +335,11 @@ class Refinement {
   // True when vertices moved.
   bool spread_unobserved() {
     if (!spreads_) return false;
-    const std::vector<std::uint8_t> poor =
+    std::vector<std::uint8_t> poor =
         poorly_observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement, data_.on_rim);
+    // Kept among those after their erosion: growing the hardly observed set by the ring instead
+    // spread more of a bumpy object's underside (bumpy sphere 0.00173 → 0.00241).
+    if (spread_fraction_ < 1) keep_hardly_observed(poor, speed_iterations_, level_iterations_, spread_fraction_);
     const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const DisplacementResult result = spread_displacement(mesh_, reference_, poor);
     if (result.moved_vertices > 0) limit_to_silhouettes(before);
@@ -347,6 +367,10 @@ class Refinement {
     const std::size_t faces = mesh_.n_faces();
     const RefinementResult result = refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
     if (spreads_) extend_reference(reference_, result.parents);
+    if (spreads_ && mesh_.n_faces() != faces) {  // a new resolution: its own counts
+      speed_iterations_.assign(mesh_.n_vertices(), 0);
+      level_iterations_ = 0;
+    }
     report.refined_faces += mesh_.n_faces() - faces;
     report.declined_vertices += result.declined;
     seconds += seconds_since(start);
@@ -371,13 +395,20 @@ class Refinement {
     }
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     const auto start = Clock::now();
+    const std::vector<Eigen::Vector3d> flowed = spreads_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const bool spread = spread_unobserved();
     const std::optional<UntanglingResult> untangled = untangle_folds();
     if (spread || (untangled && untangled->rounds > 0)) update_curvature();  // the marks follow the moves
     double seconds = seconds_since(start);
     const bool refined = adapt(report, seconds);
     report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
-    if (!refined) return false;
+    if (!refined) {
+      // The finest resolution: the flow has the last word (the run's end untangles again). The
+      // spread placed only the vertices the refinement will split; after the finest level it
+      // undid what the flow had recovered of weakly seen regions (README, "Weakly seen regions").
+      if (spread) set_positions(mesh_, flowed);
+      return false;
+    }
     report.stop = std::string("refined (") + to_string(reason) + ")";
     data_.reset_topology();
     graph_.reset();
@@ -430,6 +461,11 @@ class Refinement {
   std::size_t untangled_pairs_ = 0;
   bool rims_from_masks_ = false;  //!< the silhouettes are the scene's mask images (Scene::masks)
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
+  //! Of those, only the ones with a speed in at most this fraction of the resolution's iterations
+  //! (1: all; UnobservedDisplacementOptions::hardly_observed_fraction).
+  double spread_fraction_ = 1.0;
+  std::vector<std::uint32_t> speed_iterations_;  //!< per vertex, iterations at this resolution with a speed
+  int level_iterations_ = 0;                      //!< iterations at this resolution
   // Where each vertex was when the flow started (UnobservedDisplacementOptions), midpoints for the
   // vertices refinement added; empty when the option is off.
   std::vector<Eigen::Vector3d> reference_;

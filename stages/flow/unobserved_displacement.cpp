@@ -20,6 +20,8 @@ void UnobservedDisplacementOptions::check() const {
   require_option(observed_angle_degrees > 0 && observed_angle_degrees <= 90, "observed_angle_degrees",
                  observed_angle_degrees, "(0, 90]");
   require_option(erode_rings >= 0 && erode_rings <= 100, "erode_rings", erode_rings, "[0, 100]");
+  require_option(hardly_observed_fraction >= 0 && hardly_observed_fraction <= 1, "hardly_observed_fraction",
+                 hardly_observed_fraction, "[0, 1]");
 }
 
 namespace {
@@ -104,6 +106,26 @@ std::size_t drop_unanchored(const TriMesh& mesh, std::vector<std::uint8_t>& is_f
   return dropped;
 }
 
+// The poor set grown by rings (a vertex becomes poor when one of its one ring is), then the
+// vertices on the silhouettes cleared: the observed set eroded.
+std::vector<std::uint8_t> grow_by_rings(const TriMesh& mesh, std::vector<std::uint8_t> poor, int rings,
+                                        std::span<const std::uint8_t> on_silhouette) {
+  std::vector<std::uint8_t> next;
+  for (int ring = 0; ring < rings; ++ring) {
+    next = poor;
+    for (auto v : mesh.vertices())
+      for (auto w : mesh.vv_range(v))
+        if (poor[static_cast<std::size_t>(w.idx())]) {
+          next[static_cast<std::size_t>(v.idx())] = 1;
+          break;
+        }
+    poor.swap(next);
+  }
+  for (std::size_t v = 0; v < on_silhouette.size(); ++v)
+    if (on_silhouette[v]) poor[v] = 0;
+  return poor;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
@@ -131,20 +153,17 @@ std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const st
       }
     }
   }
-  std::vector<std::uint8_t> next;
-  for (int ring = 0; ring < options.erode_rings; ++ring) {
-    next = poor;
-    for (auto v : mesh.vertices())
-      for (auto w : mesh.vv_range(v))
-        if (poor[static_cast<std::size_t>(w.idx())]) {
-          next[static_cast<std::size_t>(v.idx())] = 1;
-          break;
-        }
-    poor.swap(next);
-  }
-  for (std::size_t v = 0; v < on_silhouette.size(); ++v)
-    if (on_silhouette[v]) poor[v] = 0;
-  return poor;
+  return grow_by_rings(mesh, poor, options.erode_rings, on_silhouette);
+}
+
+void keep_hardly_observed(std::vector<std::uint8_t>& poor, std::span<const std::uint32_t> speed_iterations,
+                          int iterations, double fraction) {
+  MVFLOW_CHECK(speed_iterations.size() == poor.size(), "keep_hardly_observed: " +
+                                                           std::to_string(speed_iterations.size()) + " counts for " +
+                                                           std::to_string(poor.size()) + " vertices");
+  const double most = fraction * iterations;
+  for (std::size_t v = 0; v < poor.size(); ++v)
+    if (speed_iterations[v] > most) poor[v] = 0;
 }
 
 DisplacementResult spread_displacement(TriMesh& mesh, std::span<const Eigen::Vector3d> reference,
