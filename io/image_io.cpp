@@ -285,7 +285,7 @@ Image read_image(const std::filesystem::path& file) {
   check_image_size(file, static_cast<std::uint64_t>(decoded.cols), static_cast<std::uint64_t>(decoded.rows));
   // Straight into the Image's buffer, then blue and red swapped in place: no second copy of the
   // decoded image.
-  Image image(decoded.cols, decoded.rows);
+  Image image = Image::uninitialized(decoded.cols, decoded.rows);  // every value written below
   cv::Mat target(decoded.rows, decoded.cols, CV_32FC3, image.data());  // wraps the Image's buffer
   decoded.convertTo(target, CV_32FC3, scale);
   decoded.release();

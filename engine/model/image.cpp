@@ -2,19 +2,67 @@
 
 #include <cassert>
 #include <cmath>
+#include <cstdlib>
+#include <new>
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 #include "engine/model/error.h"
 
 namespace mvflow {
 
-Image::Image(int width, int height)
-    : Image(width, height, std::vector<float>(static_cast<std::size_t>(width) * height * 3, 0.0f)) {}
+namespace detail {
 
-Image::Image(int width, int height, std::vector<float> rgb)
-    : width_(width), height_(height), rgb_(std::move(rgb)) {
+namespace {
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+}  // namespace
+
+template <typename T>
+void* PixelAllocator<T>::allocate_pixel_bytes(std::size_t bytes) {
+#ifdef __linux__
+  if (bytes >= kHugePage) {
+    const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    void* p = std::aligned_alloc(kHugePage, rounded);
+    if (!p) throw std::bad_alloc();
+    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: without huge pages it is ordinary memory
+    return p;
+  }
+#endif
+  void* p = std::malloc(bytes == 0 ? 1 : bytes);
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+
+template <typename T>
+void PixelAllocator<T>::free_pixel_bytes(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+
+template struct PixelAllocator<float>;
+
+}  // namespace detail
+
+Image::Image(int width, int height) : width_(width), height_(height) {
   MVFLOW_CHECK(width >= 0 && height >= 0, "image size must not be negative");
-  MVFLOW_CHECK(rgb_.size() == static_cast<std::size_t>(width) * height * 3,
+  rgb_.assign(static_cast<std::size_t>(width) * height * 3, 0.0f);
+}
+
+Image::Image(int width, int height, const std::vector<float>& rgb) : width_(width), height_(height) {
+  MVFLOW_CHECK(width >= 0 && height >= 0, "image size must not be negative");
+  MVFLOW_CHECK(rgb.size() == static_cast<std::size_t>(width) * height * 3,
                "image buffer size must be width*height*3");
+  rgb_.assign(rgb.begin(), rgb.end());
+}
+
+Image Image::uninitialized(int width, int height) {
+  MVFLOW_CHECK(width >= 0 && height >= 0, "image size must not be negative");
+  Image image;
+  image.width_ = width;
+  image.height_ = height;
+  image.rgb_.resize(static_cast<std::size_t>(width) * height * 3);  // default-initialized: not zeroed
+  return image;
 }
 
 Eigen::Vector3f Image::pixel(int x, int y) const {

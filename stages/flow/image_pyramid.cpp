@@ -6,7 +6,7 @@ namespace mvflow {
 
 Image half_image(const Image& image) {
   const int width = image.width() / 2, height = image.height() / 2;
-  Image half(width, height);
+  Image half = Image::uninitialized(width, height);  // every value written below
   const float* source = image.data();
   float* target = half.data();
   const std::size_t stride = static_cast<std::size_t>(image.width()) * 3;

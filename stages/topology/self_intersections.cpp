@@ -72,19 +72,27 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(con
   auto cell_of = [&](const Eigen::Vector3d& p) {
     return ((p - lo) / cell).array().floor().cast<int>().cwiseMax(0).cwiseMin(dims.array() - 1).matrix().eval();
   };
+  auto cell_id = [&](const Eigen::Vector3i& c) {
+    return (static_cast<std::int64_t>(c.z()) * dims.y() + c.y()) * dims.x() + c.x();
+  };
+  std::vector<Eigen::Vector3d> box_lo(n), box_hi(n);  // each face's bounding box
+  parallel::parallel_for(std::size_t{0}, kChunks, [&](std::size_t chunk) {
+    for (std::size_t f = chunk_begin(chunk, n); f < chunk_begin(chunk + 1, n); ++f) {
+      const Triangle& t = triangles[f];
+      box_lo[f] = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
+      box_hi[f] = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+    }
+  });
   // (cell id, face) for every cell a face's box touches, per chunk of faces, sorted.
   using Entry = std::pair<std::int64_t, std::uint32_t>;
   std::vector<std::vector<Entry>> entries(kChunks);
   parallel::parallel_for(std::size_t{0}, kChunks, [&](std::size_t chunk) {
     for (std::size_t f = chunk_begin(chunk, n); f < chunk_begin(chunk + 1, n); ++f) {
-      const Triangle& t = triangles[f];
-      const Eigen::Vector3i c0 = cell_of(t[0].cwiseMin(t[1]).cwiseMin(t[2]));
-      const Eigen::Vector3i c1 = cell_of(t[0].cwiseMax(t[1]).cwiseMax(t[2]));
+      const Eigen::Vector3i c0 = cell_of(box_lo[f]), c1 = cell_of(box_hi[f]);
       for (int z = c0.z(); z <= c1.z(); ++z)
         for (int y = c0.y(); y <= c1.y(); ++y)
           for (int x = c0.x(); x <= c1.x(); ++x)
-            entries[chunk].emplace_back((static_cast<std::int64_t>(z) * dims.y() + y) * dims.x() + x,
-                                        static_cast<std::uint32_t>(f));
+            entries[chunk].emplace_back(cell_id(Eigen::Vector3i(x, y, z)), static_cast<std::uint32_t>(f));
     }
     std::sort(entries[chunk].begin(), entries[chunk].end());
   });
@@ -109,6 +117,11 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(con
       for (std::size_t a = begin; a < end; ++a)
         for (std::size_t b = a + 1; b < end; ++b) {
           const std::uint32_t f = mine[a].second, g = mine[b].second;
+          // Only boxes that overlap, and each pair only in the cell of their overlap's low
+          // corner (which both faces' cell ranges contain): no pair is tested twice.
+          const Eigen::Vector3d overlap_lo = box_lo[f].cwiseMax(box_lo[g]);
+          if ((overlap_lo.array() > box_hi[f].cwiseMin(box_hi[g]).array()).any()) continue;
+          if (cell_id(cell_of(overlap_lo)) != mine[begin].first) continue;
           bool shares_vertex = false;
           for (int p : corners[f])
             for (int q : corners[g]) shares_vertex |= p == q;
@@ -120,7 +133,6 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(con
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
   for (const auto& pairs : found) crossing.insert(crossing.end(), pairs.begin(), pairs.end());
   std::sort(crossing.begin(), crossing.end());
-  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
   return crossing;
 }
 

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# The 1 → 2 thread speedup of a whole `mvflow refine` (process start, image decoding and writing
+# included), in alternated pairs: on a shared machine whose speed drifts by tens of percent within
+# minutes, only a ratio taken within one pair compares, and the median of several pairs says more
+# than any single one. Prints each pair (wall seconds, and the refinement's own seconds from the
+# report) and the medians.
+#
+#   perf/thread_ratio.sh [SCENE_DIR [PAIRS [REFINE OPTIONS...]]]
+#
+# SCENE_DIR defaults to the peer-sized sphere case of perf/openmvs_case.sh (rendered when
+# missing), PAIRS to 7; MVFLOW=build/tools/mvflow and MVFLOW_KERNEL pass through.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mvflow=${MVFLOW:-build/tools/mvflow}
+scene=${1:-/tmp/mvflow-openmvs-case}
+pairs=${2:-7}
+refine_options=("${@:3}")
+[[ "$pairs" =~ ^[1-9][0-9]*$ ]] || { echo "thread_ratio.sh: PAIRS must be a positive integer, got '$pairs'" >&2; exit 2; }
+
+[ -f "$scene/synth_par.txt" ] ||
+  "$mvflow" --log-level warn synth --amplitude 0 --views 24 --width 640 --height 480 --level 6 \
+    --init offset:0.011547 --init-vertices 2562 -o "$scene" >/dev/null
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+echo "CPU: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'), $(nproc) cores; $("$mvflow" --version | grep 'photo kernel')"
+echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+for ((pair = 1; pair <= pairs; ++pair)); do
+  for threads in 1 2; do
+    start=$(date +%s.%N)
+    "$mvflow" --log-level warn refine "$scene" -o "$work/out$threads.ply" --report "$work/report$threads.json" \
+      --threads "$threads" "${refine_options[@]}" >/dev/null
+    end=$(date +%s.%N)
+    echo "$pair $threads $start $end" >> "$work/times"
+    cp "$work/report$threads.json" "$work/report_${pair}_$threads.json"
+  done
+  cmp -s "$work/out1.ply" "$work/out2.ply" || { echo "thread_ratio.sh: 1 and 2 threads gave different meshes" >&2; exit 1; }
+done
+echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
+
+python3 - "$work" "$pairs" <<'EOF'
+import json, statistics, sys
+work, pairs = sys.argv[1], int(sys.argv[2])
+wall = {}
+for line in open(work + '/times'):
+    pair, threads, start, end = line.split()
+    wall[(int(pair), int(threads))] = float(end) - float(start)
+refine = {(p, t): json.load(open(f'{work}/report_{p}_{t}.json'))['seconds'] for p in range(1, pairs + 1) for t in (1, 2)}
+whole, inner = [], []
+for p in range(1, pairs + 1):
+    whole.append(wall[(p, 1)] / wall[(p, 2)])
+    inner.append(refine[(p, 1)] / refine[(p, 2)])
+    print(f'pair {p}: wall {wall[(p, 1)]:.2f} / {wall[(p, 2)]:.2f} s = {whole[-1]:.2f}x; '
+          f'refinement {refine[(p, 1)]:.2f} / {refine[(p, 2)]:.2f} s = {inner[-1]:.2f}x')
+print(f'median 1 -> 2 thread speedup: whole refine {statistics.median(whole):.2f}x '
+      f'(pairs {min(whole):.2f}-{max(whole):.2f}), refinement alone {statistics.median(inner):.2f}x')
+EOF
