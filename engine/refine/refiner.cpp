@@ -403,8 +403,8 @@ class Refinement {
     const bool refined = adapt(report, seconds);
     report.stage_seconds[static_cast<int>(Stage::Refinement)] += seconds;
     if (!refined) {
-      // The finest resolution: the flow has the last word (the run's end untangles again). The
-      // spread placed only the vertices the refinement will split; after the finest level it
+      // The finest resolution: the flow has the last word (the run's end untangles again). A
+      // spread is kept only where a refinement and more flow follow it; after the finest level it
       // undid what the flow had recovered of weakly seen regions (README, "Weakly seen regions").
       if (spread) set_positions(mesh_, flowed);
       return false;
