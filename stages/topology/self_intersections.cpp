@@ -51,6 +51,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(con
   auto chunk_begin = [](std::size_t chunk, std::size_t count) { return count * chunk / kChunks; };
   std::vector<Triangle> triangles(n);
   std::vector<std::array<int, 3>> corners(n);
+  std::vector<Eigen::Vector3d> box_lo(n), box_hi(n);  // each face's bounding box
   parallel::parallel_for(std::size_t{0}, kChunks, [&](std::size_t chunk) {
     for (std::size_t f = chunk_begin(chunk, n); f < chunk_begin(chunk + 1, n); ++f) {
       int c = 0;
@@ -58,6 +59,9 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(con
         triangles[f][c] = to_eigen(mesh.point(v));
         corners[f][c++] = v.idx();
       }
+      const Triangle& t = triangles[f];
+      box_lo[f] = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
+      box_hi[f] = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
     }
   });
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -75,14 +79,6 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> self_intersecting_pairs(con
   auto cell_id = [&](const Eigen::Vector3i& c) {
     return (static_cast<std::int64_t>(c.z()) * dims.y() + c.y()) * dims.x() + c.x();
   };
-  std::vector<Eigen::Vector3d> box_lo(n), box_hi(n);  // each face's bounding box
-  parallel::parallel_for(std::size_t{0}, kChunks, [&](std::size_t chunk) {
-    for (std::size_t f = chunk_begin(chunk, n); f < chunk_begin(chunk + 1, n); ++f) {
-      const Triangle& t = triangles[f];
-      box_lo[f] = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
-      box_hi[f] = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
-    }
-  });
   // (cell id, face) for every cell a face's box touches, per chunk of faces, sorted.
   using Entry = std::pair<std::int64_t, std::uint32_t>;
   std::vector<std::vector<Entry>> entries(kChunks);
