@@ -7,13 +7,12 @@
 #include <fstream>
 #include <map>
 #include <vector>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "engine/model/error.h"
 #include "io/atomic_write.h"
 #include "io/little_endian.h"
+#include "io/opencv_decoder.h"
+#include "io/png_codec.h"
 
 namespace mvflow::io {
 
@@ -35,6 +34,7 @@ struct HeaderSize {
   std::uint32_t bytes_per_sample = 1;
   //! The decoder's own buffer beside that image (TIFF: one strip or tile).
   std::uint64_t buffer_bytes = 0;
+  bool is_png = false;
 };
 
 // 1, 2, 4 or 8: the sample size OpenCV gives \p bits (10, 12 and 14 bits widen to 16).
@@ -53,7 +53,7 @@ std::optional<HeaderSize> png_size(std::istream& in) {
   if (!std::equal(signature.begin(), signature.end(), header.begin())) return std::nullopt;
   if (std::string(reinterpret_cast<const char*>(header.data()) + 12, 4) != "IHDR") return std::nullopt;
   const int depth = in.get();
-  return HeaderSize{big_endian_32(&header[16]), big_endian_32(&header[20]), depth >= 1 && depth <= 8 ? 1u : 2u};
+  return HeaderSize{big_endian_32(&header[16]), big_endian_32(&header[20]), depth >= 1 && depth <= 8 ? 1u : 2u, 0, true};
 }
 
 // JPEG: walk the marker segments to the first start-of-frame (SOF0..SOF15 except DHT/JPG/DAC).
@@ -265,34 +265,12 @@ HeaderSize stated_size(const std::filesystem::path& file) {
 
 Image read_image(const std::filesystem::path& file) {
   require_file(file);
-  stated_size(file);  // first, so that a huge image is refused before anything is allocated
-  cv::Mat decoded;
-  try {
-    decoded = cv::imread(file.string(), cv::IMREAD_COLOR | cv::IMREAD_ANYDEPTH);
-  } catch (const cv::Exception& error) {
-    // OpenCV refuses some files by throwing (its own size limit, assertions in its decoders).
-    throw InputError(file, 0, "cannot decode the image: " + error.err);
-  }
-  if (decoded.empty())
-    throw InputError(file, 0, "cannot decode the image (unreadable, truncated or not an image format OpenCV reads)");
-  double scale = 1.0;
-  switch (decoded.depth()) {
-    case CV_8U: scale = 1.0 / 255.0; break;
-    case CV_16U: scale = 1.0 / 65535.0; break;
-    case CV_32F: scale = 1.0; break;
-    default: throw InputError(file, 0, "unsupported pixel depth (expected 8-bit, 16-bit or float)");
-  }
-  check_image_size(file, static_cast<std::uint64_t>(decoded.cols), static_cast<std::uint64_t>(decoded.rows));
-  // Straight into the Image's buffer, then blue and red swapped in place: no second copy of the
-  // decoded image.
-  Image image = Image::uninitialized(decoded.cols, decoded.rows);  // every value written below
-  cv::Mat target(decoded.rows, decoded.cols, CV_32FC3, image.data());  // wraps the Image's buffer
-  decoded.convertTo(target, CV_32FC3, scale);
-  decoded.release();
-  float* pixel = image.data();
-  const std::size_t n = static_cast<std::size_t>(image.width()) * static_cast<std::size_t>(image.height());
-  for (std::size_t i = 0; i < n; ++i, pixel += 3) std::swap(pixel[0], pixel[2]);
-  return image;
+  const HeaderSize stated = stated_size(file);  // first: a huge image is refused before anything is allocated
+  if (stated.is_png)
+    if (std::optional<Image> image = read_png(file)) return *std::move(image);
+  return read_image_with_opencv(file, [&file](int width, int height) {
+    check_image_size(file, static_cast<std::uint64_t>(width), static_cast<std::uint64_t>(height));
+  });
 }
 
 ImageSize read_image_size(const std::filesystem::path& file) {
@@ -302,17 +280,8 @@ ImageSize read_image_size(const std::filesystem::path& file) {
 }
 
 void write_png(const std::filesystem::path& file, const Image& image, int bits) {
-  MVFLOW_CHECK(bits == 8 || bits == 16, "PNG bit depth must be 8 or 16");
-  const cv::Mat rgb(image.height(), image.width(), CV_32FC3, const_cast<float*>(image.data()));
-  cv::Mat bgr;
-  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-  cv::Mat out;
-  const double scale = bits == 8 ? 255.0 : 65535.0;
-  bgr.convertTo(out, bits == 8 ? CV_8UC3 : CV_16UC3, scale);  // saturates: clamps to [0,1]
-  // Encoded in memory and written through a checked stream: cv::imwrite reports success on a
-  // full disk and leaves an empty file.
-  std::vector<unsigned char> bytes;
-  if (!cv::imencode(".png", out, bytes)) throw IoError(file, "cannot encode the PNG");
+  // Encoded in memory first and written through a checked stream, so that a full disk is noticed.
+  const std::vector<std::uint8_t> bytes = encode_png(image, bits);
   write_atomically(file, true, [&](std::ostream& stream) {
     stream.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   });

@@ -15,8 +15,8 @@ ctest --test-dir build --output-on-failure --parallel "$(nproc)"
 # files; the text reader; the fuzzers' regression inputs), the engine's iteration graph
 # (Refiner.*) and the worker (WorkerTest.*, with its cancel tests).
 sanitized_targets="mesh_io_test camera_formats_test colmap_binary_test scene_test image_test model_test
-  fuzz_regression_test engine_test worker_test"
-sanitized_tests='^(MeshFormat|MeshIoShared|MeshIoTest|CameraFormats|ColmapBinary|ColmapBinaryBadInput|Scene|Image|ImageIo|MaskFiles|TextReader|BuildMesh|AtomicWrite|FuzzRegression|Refiner|WorkerTest)\.'
+  fuzz_regression_test engine_test worker_test png_codec_test"
+sanitized_tests='^(MeshFormat|MeshIoShared|MeshIoTest|CameraFormats|ColmapBinary|ColmapBinaryBadInput|Scene|Image|ImageIo|PngCodec|MaskFiles|TextReader|BuildMesh|AtomicWrite|FuzzRegression|Refiner|WorkerTest)\.'
 bash tools/sanitize.sh address,undefined --targets "$sanitized_targets" -R "$sanitized_tests"
 
 MVFLOW_FUZZ_SEED=${MVFLOW_FUZZ_SEED:-1} bash tools/fuzz.sh "${MVFLOW_CHECK_FUZZ_SECONDS:-10}"

@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   g++ cmake ninja-build ccache pkg-config
   clang libclang-rt-14-dev
-  libeigen3-dev libtbb-dev libopenmesh-dev libopencv-dev libembree-dev
+  libeigen3-dev libtbb-dev libopenmesh-dev libopencv-dev libpng-dev libembree-dev
   libspdlog-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   pybind11-dev python3-dev python3-numpy python3-pytest

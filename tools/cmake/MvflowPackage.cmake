@@ -46,7 +46,7 @@ if(MVFLOW_DPKG_SHLIBDEPS)
   set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 else()
   # What dpkg-shlibdeps gives on Debian 12 (bookworm), for a machine without dpkg-dev.
-  set(CPACK_DEBIAN_PACKAGE_DEPENDS "libc6 (>= 2.35), libembree3-3 (>= 3.13.5), libfmt9 (>= 9.1.0), libgcc-s1 (>= 3.0), libopencv-core406 (>= 4.6.0), libopencv-imgcodecs406 (>= 4.6.0), libopencv-imgproc406 (>= 4.6.0), libopenmesh1 (>= 9.0), libspdlog1.10-fmt9, libstdc++6 (>= 11), libtbb12 (>= 2021.4.0)")
+  set(CPACK_DEBIAN_PACKAGE_DEPENDS "libc6 (>= 2.35), libembree3-3 (>= 3.13.5), libfmt9 (>= 9.1.0), libgcc-s1 (>= 3.0), libopencv-core406 (>= 4.6.0), libopencv-imgcodecs406 (>= 4.6.0), libpng16-16 (>= 1.6.2), libopenmesh1 (>= 9.0), libspdlog1.10-fmt9, libstdc++6 (>= 11), libtbb12 (>= 2021.4.0)")
 endif()
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "libeigen3-dev, libtbb-dev, libopenmesh-dev, libopencv-dev, libembree-dev, libspdlog-dev, nlohmann-json3-dev")
 include(CPack)

@@ -1,0 +1,21 @@
+#pragma once
+// Images other than PNG, decoded by OpenCV in a module loaded on first use (io/opencv_decoder_abi.h).
+
+#include <filesystem>
+#include <functional>
+
+#include "engine/model/image.h"
+
+namespace mvflow::io {
+
+//! Checks a decoded size before anything is allocated; throws to refuse it.
+using SizeCheck = std::function<void(int width, int height)>;
+
+//! Decodes \p file with OpenCV's imread (IMREAD_COLOR | IMREAD_ANYDEPTH): RGB, values in [0,1].
+//! The module is looked for in $MVFLOW_OPENCV_DECODER, then where the build put it, then where
+//! `cmake --install` puts it.
+//! \throw InputError when OpenCV cannot decode the file; whatever \p check throws; Error when the
+//!        module cannot be loaded (naming every place looked in).
+Image read_image_with_opencv(const std::filesystem::path& file, const SizeCheck& check);
+
+}  // namespace mvflow::io
