@@ -1,6 +1,7 @@
-// Fuzz target: silhouette mask files. The first byte picks the extension (the PNG and JPEG headers
-// are read by mvflow itself, the rest by OpenCV); the rest of the input becomes the file, read as
-// `mvflow` reads a mask: its size from the header, then decoded and checked against the camera.
+// Fuzz target: silhouette mask files. The first byte picks the extension (every header is read by
+// mvflow itself; a PNG is decoded by mvflow's libpng codec, the rest by the OpenCV decoder module,
+// whatever the extension says); the rest of the input becomes the file, read as `mvflow` reads a
+// mask: its size from the header, then decoded and checked against the camera.
 
 #include <array>
 
