@@ -1,7 +1,9 @@
 #pragma once
-// Photographs through OpenCV: 8- and 16-bit PNG, TIFF, PNM (PBM/PGM/PPM), BMP, and JPEG: the
-// formats whose size mvflow reads from the header before decoding; other formats are refused.
-// Grey images become RGB, alpha is dropped, values are scaled to [0,1].
+// Photographs: 8- and 16-bit PNG, TIFF, PNM (PBM/PGM/PPM), BMP, and JPEG: the formats whose size
+// mvflow reads from the header before decoding; other formats are refused. PNG through libpng
+// (io/png_codec.h), the others through OpenCV in a module loaded on first use
+// (io/opencv_decoder.h); the same values either way. Grey images become RGB, alpha is dropped,
+// values are scaled to [0,1].
 
 #include <filesystem>
 #include <optional>

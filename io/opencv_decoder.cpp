@@ -20,13 +20,11 @@ struct LoadedDecoder {
   std::string failure;  // why no module could be loaded, when decode is null
 };
 
-// Every place the module may be, in order: the environment's choice, the build tree, the install.
+// Every place the module may be, in order: the environment's choice alone when it is set, else
+// the build tree, then the install.
 std::vector<std::string> module_candidates() {
-  std::vector<std::string> candidates;
-  if (const char* chosen = std::getenv("MVFLOW_OPENCV_DECODER"); chosen && *chosen) candidates.emplace_back(chosen);
-  candidates.emplace_back(MVFLOW_OPENCV_DECODER_BUILT);
-  candidates.emplace_back(MVFLOW_OPENCV_DECODER_INSTALLED);
-  return candidates;
+  if (const char* chosen = std::getenv("MVFLOW_OPENCV_DECODER"); chosen && *chosen) return {chosen};
+  return {MVFLOW_OPENCV_DECODER_BUILT, MVFLOW_OPENCV_DECODER_INSTALLED};
 }
 
 LoadedDecoder load_decoder() {
@@ -37,7 +35,7 @@ LoadedDecoder load_decoder() {
     void* module = dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!module) {
       const char* reason = dlerror();
-      tried += "\n  " + candidate + ": " + (reason ? reason : "cannot be loaded");
+      tried += "\n  " + (reason ? std::string(reason) : candidate + ": cannot be loaded");  // dlerror names the file
       continue;
     }
     const auto abi = reinterpret_cast<mvflow_opencv_decoder_abi_function>(dlsym(module, "mvflow_opencv_decoder_abi"));
@@ -50,7 +48,7 @@ LoadedDecoder load_decoder() {
     return loaded;
   }
   loaded.failure = "mvflow decodes images other than PNG with its OpenCV decoder module, which cannot be loaded:" + tried +
-                   "\n(set MVFLOW_OPENCV_DECODER to the module's path: libmvflow_opencv_decoder.so)";
+                   "\n(MVFLOW_OPENCV_DECODER=PATH names the module, libmvflow_opencv_decoder.so)";
   return loaded;
 }
 
@@ -80,9 +78,19 @@ float* allocate_image(void* context, int width, int height) {
 
 }  // namespace
 
+std::string opencv_decoder_summary() {
+  std::string looked;
+  for (const std::string& candidate : module_candidates()) {
+    std::error_code error;
+    if (std::filesystem::is_regular_file(candidate, error)) return "PNG by libpng, other formats by OpenCV (" + candidate + ")";
+    looked += (looked.empty() ? "" : ", ") + candidate;
+  }
+  return "PNG by libpng; the OpenCV decoder module for other formats is missing (looked for " + looked + ")";
+}
+
 Image read_image_with_opencv(const std::filesystem::path& file, const SizeCheck& check) {
   const LoadedDecoder& loaded = decoder();
-  if (!loaded.decode) throw Error(loaded.failure);
+  if (!loaded.decode) throw Error(file.string() + ": " + loaded.failure);
   Allocation allocation;
   allocation.check = &check;
   char reason[512] = {};

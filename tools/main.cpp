@@ -8,6 +8,7 @@
 #include <string>
 
 #include "engine/model/error.h"
+#include "io/opencv_decoder.h"
 #include "stages/flow/photo_kernel.h"
 #include "tools/commands.h"
 
@@ -24,7 +25,8 @@ int main(int argc, char** argv) {
   } catch (const mvflow::Error& e) {
     kernel = e.what();
   }
-  app.set_version_flag("--version", std::string("mvflow ") + MVFLOW_VERSION + "\nphoto kernel: " + kernel);
+  app.set_version_flag("--version", std::string("mvflow ") + MVFLOW_VERSION + "\nphoto kernel: " + kernel +
+                                        "\nimages: " + mvflow::io::opencv_decoder_summary());
   app.require_subcommand(1);
   app.fallthrough();
   bool verbose = false;
