@@ -2,6 +2,7 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <exception>
 #include <optional>
@@ -20,11 +21,20 @@ struct LoadedDecoder {
   std::string failure;  // why no module could be loaded, when decode is null
 };
 
-// Every place the module may be, in order: the environment's choice alone when it is set, else
-// the build tree, then the install.
+// Every place the module may be, in order: the environment's choice alone when it is set; else
+// beside the running program as the install lays it out (<bin>/../lib/mvflow/), the build tree,
+// and the configured install prefix.
 std::vector<std::string> module_candidates() {
   if (const char* chosen = std::getenv("MVFLOW_OPENCV_DECODER"); chosen && *chosen) return {chosen};
-  return {MVFLOW_OPENCV_DECODER_BUILT, MVFLOW_OPENCV_DECODER_INSTALLED};
+  std::vector<std::string> candidates;
+  std::error_code error;
+  const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error)
+    candidates.push_back(
+        (program.parent_path() / MVFLOW_OPENCV_DECODER_FROM_PROGRAM / MVFLOW_OPENCV_DECODER_NAME).lexically_normal().string());
+  for (const char* fixed : {MVFLOW_OPENCV_DECODER_BUILT, MVFLOW_OPENCV_DECODER_INSTALLED})
+    if (std::find(candidates.begin(), candidates.end(), fixed) == candidates.end()) candidates.emplace_back(fixed);
+  return candidates;
 }
 
 LoadedDecoder load_decoder() {

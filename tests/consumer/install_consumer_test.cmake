@@ -44,6 +44,17 @@ run("mvflow --version" ${prefix}/bin/mvflow --version)
 if(NOT output MATCHES "^mvflow ${VERSION}\n")
   message(FATAL_ERROR "the installed mvflow --version says:\n${output}")
 endif()
+# The installed program uses the installed OpenCV decoder module (found beside it, not in the
+# build tree).
+file(GLOB module ${prefix}/lib*/mvflow/libmvflow_opencv_decoder.so)
+if(NOT module)
+  message(FATAL_ERROR "no OpenCV decoder module under ${prefix}/lib*/mvflow")
+endif()
+get_filename_component(module ${module} REALPATH)
+string(FIND "${output}" "other formats by OpenCV (${module})" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "the installed mvflow does not use the installed decoder module ${module}:\n${output}")
+endif()
 
 set(configure -S ${CMAKE_CURRENT_LIST_DIR} -B ${WORK_DIR}/build -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release
   -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_PREFIX_PATH=${prefix} -DMVFLOW_EXPECTED_VERSION=${VERSION})
