@@ -89,8 +89,6 @@ void write_png_of_kind(const std::filesystem::path& file, const PngKind& kind, i
   const std::size_t row_bytes = png_get_rowbytes(png, info);
   std::vector<png_byte> samples(row_bytes * height);
   for (png_byte& b : samples) b = static_cast<png_byte>(random());
-  if (kind.colour == PNG_COLOR_TYPE_PALETTE && kind.depth == 8)
-    for (png_byte& b : samples) b = static_cast<png_byte>(b % 256);
   std::vector<png_bytep> rows(height);
   for (int y = 0; y < height; ++y) rows[y] = samples.data() + y * row_bytes;
   png_write_image(png, rows.data());
