@@ -13,10 +13,11 @@ ctest --test-dir build --output-on-failure --parallel "$(nproc)"
 # (every mvflow library and the mvflow program): the tests of every parser (meshes; Middlebury,
 # COLMAP text and binary, PhotoModeler cameras; scenes with their bounding boxes; images; mask
 # files; the text reader; the fuzzers' regression inputs), the engine's iteration graph
-# (Refiner.*) and the worker (WorkerTest.*, with its cancel tests).
+# (Refiner.*), the worker (WorkerTest.*, with its cancel tests) and the vertex renumbering every
+# refinement runs (VertexOrder.*).
 sanitized_targets="mesh_io_test camera_formats_test colmap_binary_test scene_test image_test model_test
-  fuzz_regression_test engine_test worker_test png_codec_test"
-sanitized_tests='^(MeshFormat|MeshIoShared|MeshIoTest|CameraFormats|ColmapBinary|ColmapBinaryBadInput|Scene|Image|ImageIo|PngCodec|MaskFiles|TextReader|BuildMesh|AtomicWrite|FuzzRegression|Refiner|WorkerTest)\.'
+  fuzz_regression_test engine_test worker_test png_codec_test stages_vertex_order_test"
+sanitized_tests='^(MeshFormat|MeshIoShared|MeshIoTest|CameraFormats|ColmapBinary|ColmapBinaryBadInput|Scene|Image|ImageIo|PngCodec|MaskFiles|TextReader|BuildMesh|AtomicWrite|FuzzRegression|Refiner|WorkerTest|VertexOrder)\.'
 bash tools/sanitize.sh address,undefined --targets "$sanitized_targets" -R "$sanitized_tests"
 
 MVFLOW_FUZZ_SEED=${MVFLOW_FUZZ_SEED:-1} bash tools/fuzz.sh "${MVFLOW_CHECK_FUZZ_SECONDS:-10}"

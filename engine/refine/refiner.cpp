@@ -25,6 +25,7 @@
 #include "stages/flow/regularization.h"
 #include "stages/topology/remeshing.h"
 #include "stages/topology/self_intersections.h"
+#include "stages/topology/vertex_order.h"
 #include "stages/flow/silhouette.h"
 #include "stages/flow/silhouette_constraint.h"
 #include "stages/flow/silhouette_rims.h"
@@ -289,7 +290,11 @@ class Refinement {
     reference_edge_ = edge_lengths(mesh_).shortest;
     pixel_size_ = finest_pixel_size(full_views_, bounding_box_of(mesh_).centre());
     if (!(reference_edge_ > 0)) throw InputError("the initial mesh has an edge of length zero");
-    if (options_.global_remeshing) remesh_edges(mesh_, reference_edge_, options_.remeshing);
+    if (options_.global_remeshing) {
+      remesh_edges(mesh_, reference_edge_, options_.remeshing);
+      // Neighbours close in memory: at 2 threads a block's one rings stay in its block.
+      order_vertices_by_locality(mesh_);
+    }
     apply_smoothing(mesh_, options_.smoothing);
     apply_regularization(mesh_, options_.regularization);
     if (spreads_) reference_ = positions_of(mesh_);
@@ -367,6 +372,10 @@ class Refinement {
     const std::size_t faces = mesh_.n_faces();
     const RefinementResult result = refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
     if (spreads_) extend_reference(reference_, result.parents);
+    if (mesh_.n_faces() != faces) {  // the added vertices were appended far from their neighbours
+      const std::vector<std::uint32_t> new_of_old = order_vertices_by_locality(mesh_);
+      if (spreads_ && !new_of_old.empty()) renumber_vertices(reference_, new_of_old);
+    }
     if (spreads_ && mesh_.n_faces() != faces) {  // a new resolution: its own counts
       speed_iterations_.assign(mesh_.n_vertices(), 0);
       level_iterations_ = 0;

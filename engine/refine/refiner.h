@@ -44,6 +44,8 @@ struct RefineControl {
 struct RefineResult {
   RefineSummary summary;
   //! The refined surface with per-vertex colour (mean of the visible views) and quality (g).
+  //! Its vertices are in the Morton order of their positions whenever the split/collapse or an
+  //! adaptive refinement ran (order_vertices_by_locality), else in the initial mesh's order.
   Mesh mesh;
 };
 
