@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <OpenMesh/Tools/Utils/MeshCheckerT.hh>
+
 #include "engine/model/error.h"
 #include "stages/topology/vertex_order.h"
 #include "stages_meshes.h"
@@ -75,6 +77,8 @@ TEST(VertexOrder, KeepsTheSurfaceAndRenumbersByAPermutation) {
   EXPECT_EQ(oriented_triangles(mesh), oriented_triangles(before, &new_of_old));
   EXPECT_EQ(mesh.n_edges(), before.n_edges());
   for (auto v : mesh.vertices()) EXPECT_FALSE(mesh.is_boundary(v));
+  // Every link consistent: next/prev, opposites, each vertex's and face's halfedge.
+  EXPECT_TRUE(OpenMesh::Utils::MeshCheckerT<TriMesh>(mesh).check());
 }
 
 TEST(VertexOrder, PutsOneRingsIntoTheSameBlocks) {
@@ -86,18 +90,39 @@ TEST(VertexOrder, PutsOneRingsIntoTheSameBlocks) {
   EXPECT_GT(ordered, 0.6) << "shuffled " << shuffled;
 }
 
+// The triangles in face order, each with its lowest corner first.
+std::vector<Triangle> rotated_triangles(const TriMesh& mesh) {
+  std::vector<Triangle> triangles = triangles_of(mesh);
+  for (Triangle& t : triangles) std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+  return triangles;
+}
+
 TEST(VertexOrder, IsItsOwnFixedPointAndIndependentOfTheInputOrder) {
   TriMesh a = shuffled_icosphere(3);
   TriMesh b = test::icosphere(1.0, 3);
   order_vertices_by_locality(a);
   order_vertices_by_locality(b);
-  // The order depends on the positions only: both numberings of the same sphere end the same.
+  // The order depends on the positions only: both numberings of the same sphere end the same,
+  // the faces sorted by their corners (lowest first).
   EXPECT_EQ(positions_of(a), positions_of(b));
-  EXPECT_EQ(triangles_of(a), triangles_of(b));
+  const std::vector<Triangle> faces = rotated_triangles(a);
+  EXPECT_EQ(faces, rotated_triangles(b));
+  EXPECT_TRUE(std::is_sorted(faces.begin(), faces.end()));
   // Ordering an ordered mesh changes nothing.
+  const std::vector<Triangle> before = triangles_of(a);
   const std::vector<std::uint32_t> again = order_vertices_by_locality(a);
   for (std::uint32_t v = 0; v < again.size(); ++v) ASSERT_EQ(again[v], v);
-  EXPECT_EQ(triangles_of(a), triangles_of(b));
+  EXPECT_EQ(triangles_of(a), before);
+}
+
+TEST(VertexOrder, LeavesAMeshWithOtherPropertiesUntouched) {
+  TriMesh mesh = shuffled_icosphere(2);
+  mesh.request_vertex_status();  // a property the renumbering would not carry along
+  const std::vector<Eigen::Vector3d> before = positions_of(mesh);
+  EXPECT_TRUE(order_vertices_by_locality(mesh).empty());
+  EXPECT_EQ(positions_of(mesh), before);
+  mesh.release_vertex_status();  // released, it carries nothing: renumbered again
+  EXPECT_EQ(order_vertices_by_locality(mesh).size(), before.size());
 }
 
 TEST(VertexOrder, KeepsAnOpenMeshOpenAndAnEmptyMeshEmpty) {
@@ -115,6 +140,7 @@ TEST(VertexOrder, KeepsAnOpenMeshOpenAndAnEmptyMeshEmpty) {
   const std::vector<std::uint32_t> new_of_old = order_vertices_by_locality(mesh);
   ASSERT_EQ(new_of_old.size(), 9u);
   EXPECT_EQ(oriented_triangles(mesh), oriented_triangles(before, &new_of_old));
+  EXPECT_TRUE(OpenMesh::Utils::MeshCheckerT<TriMesh>(mesh).check());
   for (std::uint32_t v = 0; v < 9; ++v)
     EXPECT_EQ(mesh.is_boundary(TriMesh::VertexHandle(static_cast<int>(new_of_old[v]))),
               before.is_boundary(TriMesh::VertexHandle(static_cast<int>(v))));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <string>
 #include <utility>
 
 namespace mvflow {
@@ -28,11 +29,26 @@ std::uint64_t morton_key(const Eigen::Vector3d& p, const Eigen::Vector3d& low, c
   return key;
 }
 
+// True when \p mesh stores nothing per element but its points (the rebuild carries only those):
+// the element-data slots OpenMesh adds (empty with mvflow's traits) and released properties hold
+// nothing.
+bool carries_only_points(const TriMesh& mesh) {
+  const auto only = [](auto begin, auto end, const std::string& placeholder, const std::string& allowed) {
+    for (auto it = begin; it != end; ++it)
+      if (*it && (*it)->name() != placeholder && (*it)->name() != allowed) return false;
+    return true;
+  };
+  return only(mesh.vprops_begin(), mesh.vprops_end(), "<vprop>", "v:points") &&
+         only(mesh.hprops_begin(), mesh.hprops_end(), "<hprop>", "") &&
+         only(mesh.eprops_begin(), mesh.eprops_end(), "<eprop>", "") &&
+         only(mesh.fprops_begin(), mesh.fprops_end(), "<fprop>", "");
+}
+
 }  // namespace
 
 std::vector<std::uint32_t> order_vertices_by_locality(TriMesh& mesh) {
   const std::size_t n = mesh.n_vertices();
-  if (n == 0) return {};
+  if (n == 0 || !carries_only_points(mesh)) return {};
   const std::vector<Eigen::Vector3d> positions = positions_of(mesh);
   Eigen::Vector3d low = positions[0], high = positions[0];
   for (const Eigen::Vector3d& p : positions) {
