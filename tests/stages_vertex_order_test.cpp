@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <set>
@@ -123,6 +124,15 @@ TEST(VertexOrder, LeavesAMeshWithOtherPropertiesUntouched) {
   EXPECT_EQ(positions_of(mesh), before);
   mesh.release_vertex_status();  // released, it carries nothing: renumbered again
   EXPECT_EQ(order_vertices_by_locality(mesh).size(), before.size());
+}
+
+TEST(VertexOrder, LeavesAMeshWithANonFiniteVertexUntouched) {
+  TriMesh mesh = shuffled_icosphere(2);
+  mesh.set_point(TriMesh::VertexHandle(5), OpenMesh::Vec3d(std::nan(""), 0.0, 0.0));
+  const std::vector<Triangle> before = triangles_of(mesh);
+  EXPECT_TRUE(order_vertices_by_locality(mesh).empty());
+  EXPECT_EQ(triangles_of(mesh), before);
+  EXPECT_TRUE(std::isnan(mesh.point(TriMesh::VertexHandle(5))[0]));
 }
 
 TEST(VertexOrder, KeepsAnOpenMeshOpenAndAnEmptyMeshEmpty) {

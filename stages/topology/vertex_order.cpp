@@ -50,6 +50,8 @@ std::vector<std::uint32_t> order_vertices_by_locality(TriMesh& mesh) {
   const std::size_t n = mesh.n_vertices();
   if (n == 0 || !carries_only_points(mesh)) return {};
   const std::vector<Eigen::Vector3d> positions = positions_of(mesh);
+  for (const Eigen::Vector3d& p : positions)
+    if (!p.allFinite()) return {};  // no key to give it (and the rebuild would refuse it)
   Eigen::Vector3d low = positions[0], high = positions[0];
   for (const Eigen::Vector3d& p : positions) {
     low = low.cwiseMin(p);

@@ -21,7 +21,8 @@ namespace mvflow {
 //! The same mesh gives the same order on any machine and at any thread count.
 //! \pre \p mesh has no deleted elements (ids contiguous).
 //! \return empty, with \p mesh untouched, when OpenMesh refuses the faces in the new order
-//!         (possible only for a mesh that is not a manifold), the mesh has no vertices, or it
+//!         (possible only for a mesh that is not a manifold), the mesh has no vertices or a
+//!         vertex that is not finite, or it
 //!         carries per-element properties other than its points (status, normals, ...), which the
 //!         rebuilt mesh would not have.
 std::vector<std::uint32_t> order_vertices_by_locality(TriMesh& mesh);
