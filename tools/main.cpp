@@ -19,14 +19,17 @@
 int main(int argc, char** argv) {
   using namespace mvflow::cli;
   CLI::App app{"mvflow: refines a coarse mesh of an object into a photo-consistent surface, from calibrated photographs"};
-  std::string kernel;
-  try {
-    kernel = mvflow::photo_kernel_summary();
-  } catch (const mvflow::Error& e) {
-    kernel = e.what();
-  }
-  app.set_version_flag("--version", std::string("mvflow ") + MVFLOW_VERSION + "\nphoto kernel: " + kernel +
-                                        "\nimages: " + mvflow::io::opencv_decoder_summary());
+  // Built only when asked for: the decoder module's lookup reads /proc and stats files.
+  app.set_version_flag("--version", [] {
+    std::string kernel;
+    try {
+      kernel = mvflow::photo_kernel_summary();
+    } catch (const mvflow::Error& e) {
+      kernel = e.what();
+    }
+    return std::string("mvflow ") + MVFLOW_VERSION + "\nphoto kernel: " + kernel +
+           "\nimages: " + mvflow::io::opencv_decoder_summary();
+  });
   app.require_subcommand(1);
   app.fallthrough();
   bool verbose = false;

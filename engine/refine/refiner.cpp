@@ -372,13 +372,14 @@ class Refinement {
     const std::size_t faces = mesh_.n_faces();
     const RefinementResult result = refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
     if (spreads_) extend_reference(reference_, result.parents);
-    if (mesh_.n_faces() != faces) {  // the added vertices were appended far from their neighbours
+    if (mesh_.n_faces() != faces) {  // a new resolution
+      // The added vertices were appended far from their neighbours.
       const std::vector<std::uint32_t> new_of_old = order_vertices_by_locality(mesh_);
-      if (spreads_ && !new_of_old.empty()) renumber_vertices(reference_, new_of_old);
-    }
-    if (spreads_ && mesh_.n_faces() != faces) {  // a new resolution: its own counts
-      speed_iterations_.assign(mesh_.n_vertices(), 0);
-      level_iterations_ = 0;
+      if (spreads_) {
+        if (!new_of_old.empty()) renumber_vertices(reference_, new_of_old);
+        speed_iterations_.assign(mesh_.n_vertices(), 0);  // its own counts
+        level_iterations_ = 0;
+      }
     }
     report.refined_faces += mesh_.n_faces() - faces;
     report.declined_vertices += result.declined;

@@ -5,6 +5,8 @@
 #include <string>
 #include <utility>
 
+#include "engine/model/bounding_box.h"
+
 namespace mvflow {
 
 namespace {
@@ -50,19 +52,17 @@ std::vector<std::uint32_t> order_vertices_by_locality(TriMesh& mesh) {
   const std::size_t n = mesh.n_vertices();
   if (n == 0 || !carries_only_points(mesh)) return {};
   const std::vector<Eigen::Vector3d> positions = positions_of(mesh);
-  for (const Eigen::Vector3d& p : positions)
-    if (!p.allFinite()) return {};  // no key to give it (and the rebuild would refuse it)
-  Eigen::Vector3d low = positions[0], high = positions[0];
+  BoundingBox box;
   for (const Eigen::Vector3d& p : positions) {
-    low = low.cwiseMin(p);
-    high = high.cwiseMax(p);
+    if (!p.allFinite()) return {};  // no key to give it (and the rebuild would refuse it)
+    box.extend(p);
   }
-  const Eigen::Vector3d extent = high - low;
+  const Eigen::Vector3d extent = box.size();
   Eigen::Vector3d scale;
   for (int axis = 0; axis < 3; ++axis) scale[axis] = extent[axis] > 0 ? ((1 << 21) - 1) / extent[axis] : 0.0;
 
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
-  for (std::uint32_t v = 0; v < n; ++v) keyed[v] = {morton_key(positions[v], low, scale), v};
+  for (std::uint32_t v = 0; v < n; ++v) keyed[v] = {morton_key(positions[v], box.min, scale), v};
   std::sort(keyed.begin(), keyed.end());
   std::vector<std::uint32_t> new_of_old(n);
   IndexedMesh ordered;

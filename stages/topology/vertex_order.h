@@ -19,12 +19,10 @@ namespace mvflow {
 //! their corners' new ids, each face's corners rotated, never reordered (orientation kept).
 //! Returns the new id of each old vertex; positions and connectivity are those of the input.
 //! The same mesh gives the same order on any machine and at any thread count.
-//! \pre \p mesh has no deleted elements (ids contiguous).
-//! \return empty, with \p mesh untouched, when OpenMesh refuses the faces in the new order
-//!         (possible only for a mesh that is not a manifold), the mesh has no vertices or a
-//!         vertex that is not finite, or it
-//!         carries per-element properties other than its points (status, normals, ...), which the
-//!         rebuilt mesh would not have.
+//! \return empty, with \p mesh untouched, when the mesh has no vertices or a vertex that is not
+//!         finite, when it carries per-element properties other than its points (status, so also
+//!         deleted elements, normals, ...), which the rebuilt mesh would not have, or when OpenMesh
+//!         refuses the faces in the new order (possible only for a mesh that is not a manifold).
 std::vector<std::uint32_t> order_vertices_by_locality(TriMesh& mesh);
 
 //! Applies the renumbering \p new_of_old (order_vertices_by_locality's result) to a per-vertex
