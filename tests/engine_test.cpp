@@ -5,9 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
 
 #include "cancel_probe.h"
+#include "engine/model/error.h"
 #include "engine/refine/refiner.h"
 #include "stages/eval/evaluation.h"
 #include "stages/synth/synth_scene.h"
@@ -159,6 +164,9 @@ TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {
   EXPECT_LT(after.accuracy(), 0.5 * before.accuracy());
   EXPECT_LT(result.summary.final_sum_g_per_vertex, result.summary.initial_sum_g_per_vertex);
   EXPECT_EQ(result.summary.self_intersections, 0u);
+  // The summary's initial counts are the given mesh's, not the split/collapsed one's.
+  EXPECT_EQ(result.summary.initial_vertices, s.initial.n_vertices());
+  EXPECT_EQ(result.summary.initial_faces, s.initial.n_faces());
   EXPECT_EQ(result.mesh.quality.size(), result.mesh.n_vertices());
   EXPECT_EQ(result.mesh.colors.size(), result.mesh.n_vertices());
 }
@@ -361,6 +369,26 @@ TEST(Refiner, BadInputIsAFailedStatusNotAnException) {
   options.excluded_views = {};
   options.cfl = -1;
   EXPECT_EQ(refine_mesh(s.scene, s.initial, options, {}).summary.status, RefineStatus::Failed);
+}
+
+TEST(Refiner, OfSeveralBadImagesTheFirstInViewOrderIsReportedAtAnyThreadCount) {
+  const SmallScene& s = small_scene();
+  // Views 3, 5 and 9 fail to decode; view 3 fails last in time, so a refinement that reported
+  // whichever failure came first would name 5 or 9 at 2 threads.
+  Scene scene = s.scene;
+  scene.images = std::make_shared<ImageStore>(scene.size(), [&s](std::size_t view) -> Image {
+    if (view == 3) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (view == 3 || view == 5 || view == 9) throw InputError("image of view " + std::to_string(view) + " is bad");
+    return s.scene.image(view);
+  });
+  for (int threads : {1, 2}) {
+    RefineControl control;
+    control.threads = threads;
+    const RefineResult result = refine_mesh(scene, s.initial, few_iterations(6), control);
+    EXPECT_EQ(result.summary.status, RefineStatus::Failed);
+    EXPECT_NE(result.summary.message.find("image of view 3 is bad"), std::string::npos)
+        << threads << " threads: " << result.summary.message;
+  }
 }
 
 }  // namespace

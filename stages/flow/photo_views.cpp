@@ -34,10 +34,19 @@ double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vecto
   return finest;
 }
 
+void decode_images(const ImageStore& store, std::span<const std::size_t> indices) {
+  parallel::parallel_for(std::size_t{0}, indices.size(), [&](std::size_t i) {
+    try {
+      store.get(indices[i]);
+    } catch (...) {  // oneTBB would rethrow whichever failure came first in time
+    }
+  });
+}
+
 std::vector<PhotoView> make_photo_views(const Scene& scene) {
-  // Decode the images side by side (the store is safe to use from any thread), in the caller's
-  // task arena.
-  parallel::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t i) { scene.image(i); });
+  std::vector<std::size_t> all(scene.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  decode_images(*scene.images, all);
   std::vector<PhotoView> views(scene.size());
   for (std::size_t i = 0; i < scene.size(); ++i) {
     const Camera& camera = scene.views[i].camera;

@@ -4,6 +4,8 @@
 // per-sample path then does no allocation and no virtual call.
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <span>
 #include <vector>
 
 #include "engine/model/camera.h"
@@ -40,8 +42,14 @@ std::vector<PhotoView> make_photo_views(const std::vector<Camera>& cameras, cons
 //! 0 when no view has it in front.
 double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vector3d& point);
 
-//! Views of a scene, decoding its images now (in parallel, in the current task arena).
-//! \throw what decoding throws.
+//! Decodes the images of \p store with the given \p indices side by side, in the current task
+//! arena (the store is safe to use from any thread). A failure is left for the caller's next
+//! ImageStore::get to report, so that of several bad images the first in view order is named,
+//! whatever the thread count and timing.
+void decode_images(const ImageStore& store, std::span<const std::size_t> indices);
+
+//! Views of a scene, decoding its images now (decode_images).
+//! \throw what decoding throws, for the first view whose image fails.
 std::vector<PhotoView> make_photo_views(const Scene& scene);
 
 }  // namespace mvflow
