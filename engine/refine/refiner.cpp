@@ -293,6 +293,7 @@ class Refinement {
   // image and is serial (about 25 ms of the sphere case's 1.8 s at 2 threads), decoding keeps both
   // threads busy for longer. Errors come in the order of the serial code: the views' first.
   void decode_while_preparing(const Scene& scene) {
+    const Eigen::Vector3d centre = bounding_box_of(mesh_).centre();  // of the mesh as given
     std::exception_ptr decoding_error, preparing_error;
     parallel::parallel_for(0, 2, [&](int task) {
       try {
@@ -306,7 +307,7 @@ class Refinement {
     });
     if (decoding_error) std::rethrow_exception(decoding_error);
     if (preparing_error) std::rethrow_exception(preparing_error);
-    pixel_size_ = finest_pixel_size(full_views_, bounding_box_of(mesh_).centre());
+    pixel_size_ = finest_pixel_size(full_views_, centre);
   }
 
   // Thesis §5.3.4, before the flow: split/collapse against e_S, one smoothing and one

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# tools/quality_scenes.sh on issue 12's grazing rig: its line must agree with `mvflow eval`'s JSON
+# and with the south cap's error computed here, independently, from an OBJ copy of the refined
+# mesh; --compare of a run with itself must give 1.000; a refinement that fails makes it exit 1.
+#   tests/quality_scenes_check.sh MVFLOW SOURCE_DIR WORK_DIR
+set -euo pipefail
+mvflow=$1 root=$2 work=$3
+rm -rf "$work"
+mkdir -p "$work"
+MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" a --scenes grazing > "$work/a.txt"
+MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" --compare a a > "$work/compare.txt"
+"$mvflow" --log-level warn convert "$work/runs/a/grazing.ply" "$work/grazing.obj"
+python3 - "$work" <<'PY'
+import json, math, re, sys
+work = sys.argv[1]
+line = open(f'{work}/a.txt').read()
+evaluation = json.load(open(f'{work}/runs/a/grazing.eval.json'))
+mean = float(re.search(r'mean (\S+)', line).group(1))
+assert abs(mean - evaluation['symmetric_mean']) < 5e-6, (mean, evaluation['symmetric_mean'])
+complete = float(re.search(r'complete (\S+)%', line).group(1))
+assert abs(complete - 100 * evaluation['completeness']) < 5e-4, (complete, evaluation['completeness'])
+ratio, cap, rest = (float(x) for x in re.search(r'cap (\S+)x \((\S+) / (\S+)\)', line).groups())
+south, others = [], []
+for text in open(f'{work}/grazing.obj'):
+    if text.startswith('v '):
+        x, y, z = (float(c) for c in text.split()[1:4])
+        r = math.sqrt(x * x + y * y + z * z)
+        (south if y / r < -math.sin(math.radians(55)) else others).append(abs(r - 1))
+expected_cap, expected_rest = sum(south) / len(south), sum(others) / len(others)
+assert len(south) > 100, len(south)
+assert abs(cap - expected_cap) < 1e-4 and abs(rest - expected_rest) < 1e-4, (cap, rest, expected_cap, expected_rest)
+assert abs(ratio - expected_cap / expected_rest) < 0.01, (ratio, expected_cap / expected_rest)
+compare = open(f'{work}/compare.txt').read()
+assert "geometric mean 1.000 over 1 scenes" in compare and "identical meshes: 1 of 1" in compare, compare
+print('quality_scenes.sh agrees with mvflow eval and with the cap computed from the OBJ:', line.strip())
+PY
+if MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" b --scenes grazing -- --cfl 99 > "$work/b.txt" 2>&1; then
+  echo "a failed refinement did not make quality_scenes.sh fail" >&2
+  exit 1
+fi
+grep -q "grazing refine FAILED" "$work/b.txt"

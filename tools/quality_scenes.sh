@@ -1,0 +1,161 @@
+#!/usr/bin/env bash
+# The README's synthetic quality yardstick in one command: renders the textured scenes (once),
+# refines each with the given options, scores it against its ground truth with `mvflow eval`,
+# and, on the unit spheres, the error of the weakly seen south cap against the rest (issue 12).
+#
+#   bash tools/quality_scenes.sh OUT TAG [--scenes "a b ..."] [-- REFINE OPTIONS...]
+#   bash tools/quality_scenes.sh OUT --compare TAG_A TAG_B
+#
+# Scenes (README "Quality", "Weakly seen regions"): bumpy, peanut, bunny (the three quality
+# scenes, tuned on); grazing and peer (the unit-sphere rigs of issue 12); t1–t5 and v1–v5 (rendered
+# for checks, not tuned on). The scenes go to OUT/scenes/NAME (rendered only when missing, so
+# every TAG is scored on the same photographs), the runs to OUT/runs/TAG/NAME.{ply,json,eval.json},
+# one line per scene to OUT/runs/TAG/summary.txt and stdout. On the unit spheres (grazing, peer, t3,
+# v5) "cap" is the mean radial error of the vertices below −55° latitude over that of all others
+# (issue 12 asks ≤ 2), and "band" the mean signed radial error per 10° of latitude, south to north.
+# --compare prints, per scene, TAG_B's mean error over TAG_A's (and whether the meshes are byte
+# for byte the same: a change meant to keep the results, e.g. for speed, must show 15 of 15)
+# and their geometric mean: a default
+# should win on several scenes by more than the arithmetic-order spread (README "Quality": e.g.
+# the peanut 0.00479–0.00529 for one and the same code).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+mvflow=${MVFLOW:-$root/build/tools/mvflow}  # MVFLOW: another build
+usage() { echo "usage: $0 OUT TAG [--scenes \"a b ...\"] [-- REFINE OPTIONS...] | $0 OUT --compare TAG_A TAG_B" >&2; exit 2; }
+[ $# -ge 2 ] || usage
+out=$1
+shift
+
+summarise() {  # summarise RUNS_A RUNS_B
+  python3 - "$1" "$2" <<'EOF'
+import filecmp, math, os, sys
+def read(path):
+    rows = {}
+    for line in open(path):
+        f = line.split()
+        if len(f) > 3 and f[1] == 'mean':
+            rows[f[0]] = float(f[2])
+    return rows
+runs_a, runs_b = sys.argv[1], sys.argv[2]
+a, b = read(runs_a + '/summary.txt'), read(runs_b + '/summary.txt')
+logs, identical = [], 0
+for name in a:
+    if name in b and a[name] > 0 and b[name] > 0:
+        logs.append(math.log(b[name] / a[name]))
+        same = filecmp.cmp(f'{runs_a}/{name}.ply', f'{runs_b}/{name}.ply', shallow=False)
+        identical += same
+        print(f"{name:8s} {a[name]:.5f} -> {b[name]:.5f}  {b[name] / a[name]:.3f}{'  (identical mesh)' if same else ''}")
+if not logs:
+    sys.exit("no scene in common")
+print(f"identical meshes: {identical} of {len(logs)}")
+wins = sum(l < math.log(0.97) for l in logs); losses = sum(l > math.log(1.03) for l in logs)
+print(f"geometric mean {math.exp(sum(logs) / len(logs)):.3f} over {len(logs)} scenes; "
+      f"better by > 3 % on {wins}, worse by > 3 % on {losses}")
+EOF
+}
+
+if [ "$1" = --compare ]; then
+  [ $# -eq 3 ] || usage
+  for tag in "$2" "$3"; do
+    [ -f "$out/runs/$tag/summary.txt" ] || { echo "$0: $out/runs/$tag/summary.txt is missing" >&2; exit 1; }
+  done
+  summarise "$out/runs/$2" "$out/runs/$3"
+  exit 0
+fi
+
+tag=$1
+shift
+[[ "$tag" =~ ^[A-Za-z0-9._-]+$ ]] || { echo "$0: TAG must be letters, digits, . _ -, got '$tag'" >&2; exit 2; }
+scenes="bumpy peanut bunny grazing peer t1 t2 t3 t4 t5 v1 v2 v3 v4 v5"
+while [ $# -gt 0 ]; do
+  case $1 in
+    --scenes) [ $# -ge 2 ] || usage; scenes=$2; shift 2 ;;
+    --) shift; break ;;
+    *) echo "$0: unknown option $1" >&2; usage ;;
+  esac
+done
+refine_options=("$@")
+[ -x "$mvflow" ] || { echo "$0: $mvflow is missing: build first (bash tools/build.sh)" >&2; exit 1; }
+
+rig="--amplitude 0 --views 24 --width 640 --height 480 --level 6 --init offset:0.011547 --init-vertices 2562"
+synth_options() {
+  case $1 in
+    bumpy) echo "--preset default" ;;
+    peanut) echo "--preset peanut" ;;
+    bunny) echo "--preset bunny" ;;
+    grazing) echo "$rig --elevation -15,25" ;;
+    peer) echo "$rig" ;;
+    t1) echo "--elevation -15,25 --views 24 --seed 7" ;;
+    t2) echo "--preset peanut --elevation -20,30 --views 20 --seed 3" ;;
+    t3) echo "--amplitude 0 --elevation -5,35 --views 20 --seed 5 --noise 0.01" ;;
+    t4) echo "--preset spot --seed 2" ;;
+    t5) echo "--amplitude 0.04 --frequency 8 --seed 11 --noise 0.01" ;;
+    v1) echo "--object $root/../shared/data/models/cow.obj --views 20 --elevation -10,40 --seed 21" ;;
+    v2) echo "--preset bunny --elevation -25,20 --views 24 --seed 4" ;;
+    v3) echo "--amplitude 0.12 --frequency 3 --elevation 0,50 --views 16 --seed 9 --specular 0.3" ;;
+    v4) echo "--preset peanut --rig hemisphere --views 20 --elevation -20,60 --seed 6" ;;
+    v5) echo "--amplitude 0 --views 20 --elevation -30,10 --seed 12 --noise 0.005" ;;
+    *) return 1 ;;
+  esac
+}
+for name in $scenes; do
+  synth_options "$name" > /dev/null || { echo "$0: unknown scene '$name' (known: bumpy peanut bunny grazing peer t1-t5 v1-v5)" >&2; exit 2; }
+done
+
+runs=$out/runs/$tag
+mkdir -p "$out/scenes" "$runs"
+failed=0
+: > "$runs/summary.txt"
+printf '%s\n' "${refine_options[*]:-(defaults)}" > "$runs/options.txt"
+for name in $scenes; do
+  scene=$out/scenes/$name
+  if [ ! -f "$scene/truth.ply" ]; then
+    # shellcheck disable=SC2046  # the options are words
+    "$mvflow" --log-level warn synth $(synth_options "$name") -o "$scene" > "$scene.log" 2>&1 ||
+      { echo "$0: rendering $name failed (log: $scene.log)" >&2; tail -3 "$scene.log" >&2; exit 1; }
+  fi
+  run=$runs/$name
+  if ! "$mvflow" --log-level warn refine "$scene" -o "$run.ply" --report "$run.json" "${refine_options[@]}" > "$run.log" 2>&1; then
+    echo "$name refine FAILED (log: $run.log)" | tee -a "$runs/summary.txt"
+    failed=$((failed + 1))
+    continue
+  fi
+  "$mvflow" --log-level warn eval "$run.ply" "$scene/truth.ply" --samples 50000 --json "$run.eval.json" > /dev/null
+  unit_sphere=0
+  case $name in grazing | peer | t3 | v5) unit_sphere=1 ;; esac
+  python3 - "$name" "$run" "$unit_sphere" <<'EOF' | tee -a "$runs/summary.txt"
+import json, math, struct, sys
+name, run, unit_sphere = sys.argv[1], sys.argv[2], sys.argv[3] == '1'
+e = json.load(open(run + '.eval.json')); r = json.load(open(run + '.json'))
+line = (f"{name:8s} mean {e['symmetric_mean']:.5f} acc {e['accuracy']:.5f} "
+        f"complete {100 * e['completeness']:.3f}% | {r['final']['vertices']} v., "
+        f"{len(r['iterations'])} it., {r['status']}, {r['seconds']:.2f} s")
+if unit_sphere:
+    data = open(run + '.ply', 'rb').read()
+    end = data.index(b'end_header\n') + len(b'end_header\n')
+    header = data[:end].decode().split('\n')
+    count = int(next(l for l in header if l.startswith('element vertex')).split()[2])
+    sizes = {'char': 'b', 'uchar': 'B', 'short': 'h', 'ushort': 'H', 'int': 'i', 'uint': 'I', 'float': 'f', 'double': 'd'}
+    props, element = [], None
+    for l in header:
+        if l.startswith('element'): element = l.split()[1]
+        elif l.startswith('property') and element == 'vertex': props.append(l.split())
+    layout = '<' + ''.join(sizes[p[1]] for p in props); names = [p[2] for p in props]
+    stride = struct.calcsize(layout); ix, iy, iz = (names.index(c) for c in 'xyz')
+    cap, rest, bands = [], [], {}
+    for i in range(count):
+        v = struct.unpack_from(layout, data, end + i * stride)
+        radius = math.sqrt(v[ix] ** 2 + v[iy] ** 2 + v[iz] ** 2)
+        latitude = math.degrees(math.asin(max(-1.0, min(1.0, v[iy] / radius))))
+        (cap if latitude < -55 else rest).append(abs(radius - 1))
+        bands.setdefault(min(8, int((latitude + 90) // 20)), []).append(radius - 1)
+    mean = lambda a: sum(a) / len(a) if a else float('nan')
+    line += (f" | cap {mean(cap) / mean(rest):.2f}x ({mean(cap):.4f} / {mean(rest):.4f}); signed per 20° from the south "
+             + ' '.join(f"{mean(bands[b]):+.4f}" for b in sorted(bands)))
+print(line)
+EOF
+done
+if [ "$failed" -gt 0 ]; then
+  echo "$0: $failed refinement(s) failed (their logs are named above)" >&2
+  exit 1
+fi
