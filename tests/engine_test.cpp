@@ -164,7 +164,9 @@ TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {
   EXPECT_LT(after.accuracy(), 0.5 * before.accuracy());
   EXPECT_LT(result.summary.final_sum_g_per_vertex, result.summary.initial_sum_g_per_vertex);
   EXPECT_EQ(result.summary.self_intersections, 0u);
-  // The summary's initial counts are the given mesh's, not the split/collapsed one's.
+  // The summary's initial counts are the given mesh's, not the split/collapsed one's (which the
+  // first iteration reports, and which differs).
+  EXPECT_NE(result.summary.iterations.front().vertices, s.initial.n_vertices());
   EXPECT_EQ(result.summary.initial_vertices, s.initial.n_vertices());
   EXPECT_EQ(result.summary.initial_faces, s.initial.n_faces());
   EXPECT_EQ(result.mesh.quality.size(), result.mesh.n_vertices());
@@ -373,11 +375,16 @@ TEST(Refiner, BadInputIsAFailedStatusNotAnException) {
 
 TEST(Refiner, OfSeveralBadImagesTheFirstInViewOrderIsReportedAtAnyThreadCount) {
   const SmallScene& s = small_scene();
-  // Views 3, 5 and 9 fail to decode; view 3 fails last in time, so a refinement that reported
-  // whichever failure came first would name 5 or 9 at 2 threads.
+  // Views 3, 5 and 9 fail to decode; view 3 fails only once another has (or after a second, when
+  // no other thread decodes meanwhile), so a refinement that reported whichever failure came first
+  // in time would name 5 or 9 at 2 threads.
+  std::atomic<bool> later_view_failed{false};
   Scene scene = s.scene;
-  scene.images = std::make_shared<ImageStore>(scene.size(), [&s](std::size_t view) -> Image {
-    if (view == 3) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  scene.images = std::make_shared<ImageStore>(scene.size(), [&](std::size_t view) -> Image {
+    if (view == 3)
+      for (int waited = 0; waited < 100 && !later_view_failed; ++waited)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (view == 5 || view == 9) later_view_failed = true;
     if (view == 3 || view == 5 || view == 9) throw InputError("image of view " + std::to_string(view) + " is bad");
     return s.scene.image(view);
   });
@@ -389,6 +396,28 @@ TEST(Refiner, OfSeveralBadImagesTheFirstInViewOrderIsReportedAtAnyThreadCount) {
     EXPECT_NE(result.summary.message.find("image of view 3 is bad"), std::string::npos)
         << threads << " threads: " << result.summary.message;
   }
+}
+
+TEST(Refiner, ABadImageIsReportedBeforeABadMeshWhileBothArePrepared) {
+  // The mesh is prepared while the images are decoded; the errors keep the serial order.
+  const SmallScene& s = small_scene();
+  Mesh degenerate = s.initial;  // vertex 1 moved onto a neighbour: an edge of length zero
+  TriMesh& mesh = degenerate.topology;
+  const auto v1 = TriMesh::VertexHandle(1);
+  mesh.set_point(v1, mesh.point(*mesh.vv_begin(v1)));
+  Scene bad_images = s.scene;
+  bad_images.images = std::make_shared<ImageStore>(s.scene.size(), [&s](std::size_t view) -> Image {
+    if (view == 2) throw InputError("image of view 2 is bad");
+    return s.scene.image(view);
+  });
+  RefineControl control;
+  control.threads = 2;
+  const RefineResult both = refine_mesh(bad_images, degenerate, few_iterations(6), control);
+  EXPECT_EQ(both.summary.status, RefineStatus::Failed);
+  EXPECT_NE(both.summary.message.find("image of view 2 is bad"), std::string::npos) << both.summary.message;
+  const RefineResult mesh_only = refine_mesh(s.scene, degenerate, few_iterations(6), control);
+  EXPECT_EQ(mesh_only.summary.status, RefineStatus::Failed);
+  EXPECT_NE(mesh_only.summary.message.find("edge of length zero"), std::string::npos) << mesh_only.summary.message;
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # tools/quality_scenes.sh on issue 12's grazing rig: its line must agree with `mvflow eval`'s JSON
 # and with the south cap's error computed here, independently, from an OBJ copy of the refined
-# mesh; --compare of a run with itself must give 1.000; a refinement that fails makes it exit 1.
+# mesh; --compare of a run with itself must give 1.000 and identical meshes, with a shorter run its
+# ratio and none; a refinement that fails makes it exit 1.
 #   tests/quality_scenes_check.sh MVFLOW SOURCE_DIR WORK_DIR
 set -euo pipefail
 mvflow=$1 root=$2 work=$3
@@ -9,6 +10,9 @@ rm -rf "$work"
 mkdir -p "$work"
 MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" a --scenes grazing > "$work/a.txt"
 MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" --compare a a > "$work/compare.txt"
+# A run that differs (stopped after 12 iterations): its ratio is not 1 and its mesh not identical.
+MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" short --scenes grazing -- --max-iterations 12 > /dev/null
+MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" --compare a short > "$work/compare_short.txt"
 "$mvflow" --log-level warn convert "$work/runs/a/grazing.ply" "$work/grazing.obj"
 python3 - "$work" <<'PY'
 import json, math, re, sys
@@ -32,6 +36,11 @@ assert abs(cap - expected_cap) < 1e-4 and abs(rest - expected_rest) < 1e-4, (cap
 assert abs(ratio - expected_cap / expected_rest) < 0.01, (ratio, expected_cap / expected_rest)
 compare = open(f'{work}/compare.txt').read()
 assert "geometric mean 1.000 over 1 scenes" in compare and "identical meshes: 1 of 1" in compare, compare
+# --compare divides the summaries' printed means (5 decimals).
+short = float(re.search(r'mean (\S+)', open(f'{work}/runs/short/summary.txt').read()).group(1))
+ratio = f"{short / mean:.3f}"
+compare = open(f'{work}/compare_short.txt').read()
+assert ratio != "1.000" and f"{short:.5f}  {ratio}" in compare and "identical meshes: 0 of 1" in compare, compare
 print('quality_scenes.sh agrees with mvflow eval and with the cap computed from the OBJ:', line.strip())
 PY
 if MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" b --scenes grazing -- --cfl 99 > "$work/b.txt" 2>&1; then

@@ -2,6 +2,8 @@
 
 #include <oneapi/tbb/parallel_for.h>
 
+#include <atomic>
+
 #include "engine/model/error.h"
 #include "engine/model/parallel.h"
 
@@ -35,10 +37,16 @@ double finest_pixel_size(const std::vector<PhotoView>& views, const Eigen::Vecto
 }
 
 void decode_images(const ImageStore& store, std::span<const std::size_t> indices) {
+  // Past the first failure (in index order) nothing more need be decoded: the caller stops there.
+  std::atomic<std::size_t> first_failure{indices.size()};
   parallel::parallel_for(std::size_t{0}, indices.size(), [&](std::size_t i) {
+    if (i > first_failure.load(std::memory_order_relaxed)) return;
     try {
       store.get(indices[i]);
-    } catch (...) {  // oneTBB would rethrow whichever failure came first in time
+    } catch (...) {  // not rethrown: oneTBB would pass on whichever failure came first in time
+      std::size_t seen = first_failure.load(std::memory_order_relaxed);
+      while (i < seen && !first_failure.compare_exchange_weak(seen, i, std::memory_order_relaxed)) {
+      }
     }
   });
 }
