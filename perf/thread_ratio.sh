@@ -2,8 +2,10 @@
 # The 1 → 2 thread speedup of a whole `mvflow refine` (process start, image decoding and writing
 # included), in alternated pairs: on a shared machine whose speed drifts by tens of percent within
 # minutes, only a ratio taken within one pair compares, and the median of several pairs says more
-# than any single one. Prints each pair (wall seconds, and the refinement's own seconds from the
-# report) and the medians, and the ratio of the fastest run of each thread count.
+# than any single one. Prints each pair (wall seconds, the refinement's own seconds from the report,
+# split into its iterations and the rest: preparing, the evaluations, and between levels the
+# spread, untangling, refinement and renumbering) and the medians, and the ratio of the fastest run
+# of each thread count.
 #
 #   perf/thread_ratio.sh [SCENE_DIR [PAIRS [REFINE OPTIONS...]]]
 #
@@ -45,15 +47,24 @@ wall = {}
 for line in open(work + '/times'):
     pair, threads, start, end = line.split()
     wall[(int(pair), int(threads))] = float(end) - float(start)
-refine = {(p, t): json.load(open(f'{work}/report_{p}_{t}.json'))['seconds'] for p in range(1, pairs + 1) for t in (1, 2)}
-whole, inner = [], []
+reports = {(p, t): json.load(open(f'{work}/report_{p}_{t}.json')) for p in range(1, pairs + 1) for t in (1, 2)}
+refine = {k: r['seconds'] for k, r in reports.items()}
+# The iterations' own seconds, and the rest of the refinement (preparing, decoding, the initial
+# and final evaluations, the untangling at the end): the parts that scale differently.
+iterating = {k: sum(i['seconds'] for i in r['iterations']) for k, r in reports.items()}
+rest = {k: refine[k] - iterating[k] for k in reports}
+whole, inner, loop, outside = [], [], [], []
 for p in range(1, pairs + 1):
     whole.append(wall[(p, 1)] / wall[(p, 2)])
     inner.append(refine[(p, 1)] / refine[(p, 2)])
+    loop.append(iterating[(p, 1)] / iterating[(p, 2)])
+    outside.append(rest[(p, 1)] / rest[(p, 2)])
     print(f'pair {p}: wall {wall[(p, 1)]:.2f} / {wall[(p, 2)]:.2f} s = {whole[-1]:.2f}x; '
-          f'refinement {refine[(p, 1)]:.2f} / {refine[(p, 2)]:.2f} s = {inner[-1]:.2f}x')
+          f'refinement {refine[(p, 1)]:.2f} / {refine[(p, 2)]:.2f} s = {inner[-1]:.2f}x '
+          f'(iterations {loop[-1]:.2f}x, the rest {rest[(p, 1)]:.2f} / {rest[(p, 2)]:.2f} s = {outside[-1]:.2f}x)')
 print(f'median 1 -> 2 thread speedup: whole refine {statistics.median(whole):.2f}x '
-      f'(pairs {min(whole):.2f}-{max(whole):.2f}), refinement alone {statistics.median(inner):.2f}x')
+      f'(pairs {min(whole):.2f}-{max(whole):.2f}), refinement alone {statistics.median(inner):.2f}x '
+      f'(its iterations {statistics.median(loop):.2f}x, the rest {statistics.median(outside):.2f}x)')
 # On a shared machine a run is only ever slowed by others: the fastest run of each thread count
 # is the least disturbed one, so their ratio is a second estimate that drift moves less.
 fastest = {t: min(wall[(p, t)] for p in range(1, pairs + 1)) for t in (1, 2)}
