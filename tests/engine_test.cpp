@@ -398,6 +398,25 @@ TEST(Refiner, OfSeveralBadImagesTheFirstInViewOrderIsReportedAtAnyThreadCount) {
   }
 }
 
+TEST(Refiner, AnExcludedViewsPhotographIsNeverDecoded) {
+  // View 4's photograph is broken but held out: the refinement runs, and never asks for it.
+  const SmallScene& s = small_scene();
+  std::atomic<int> asked_for_4{0};
+  Scene scene = s.scene;
+  scene.images = std::make_shared<ImageStore>(scene.size(), [&](std::size_t view) -> Image {
+    if (view == 4) {
+      ++asked_for_4;
+      throw InputError("image of view 4 is bad");
+    }
+    return s.scene.image(view);
+  });
+  RefineOptions options = few_iterations(6);
+  options.excluded_views = {4};
+  const RefineResult result = refine_mesh(scene, s.initial, options, {});
+  EXPECT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+  EXPECT_EQ(asked_for_4.load(), 0);
+}
+
 TEST(Refiner, ABadImageIsReportedBeforeABadMeshWhileBothArePrepared) {
   // The mesh is prepared while the images are decoded; the errors keep the serial order.
   const SmallScene& s = small_scene();

@@ -68,10 +68,7 @@ std::vector<PhotoView> usable_views(const Scene& scene, const std::vector<int>& 
   if (kept_indices.size() < 2)
     refuse("fewer than 2 views are left to refine with (" + std::to_string(scene.size()) + " views, " +
            std::to_string(scene.size() - kept_indices.size()) + " excluded)");
-  std::vector<PhotoView> all = make_photo_views(scene);
-  std::vector<PhotoView> kept;
-  for (std::size_t i : kept_indices) kept.push_back(all[i]);
-  return kept;
+  return make_photo_views(scene, kept_indices);  // an excluded view's photograph is never decoded
 }
 
 // The silhouettes of the scene's views \p kept from its mask images (Scene::masks), as given: no

@@ -51,20 +51,25 @@ void decode_images(const ImageStore& store, std::span<const std::size_t> indices
   });
 }
 
-std::vector<PhotoView> make_photo_views(const Scene& scene) {
-  std::vector<std::size_t> all(scene.size());
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-  decode_images(*scene.images, all);
-  std::vector<PhotoView> views(scene.size());
-  for (std::size_t i = 0; i < scene.size(); ++i) {
-    const Camera& camera = scene.views[i].camera;
-    const Image& image = scene.image(i);
+std::vector<PhotoView> make_photo_views(const Scene& scene, std::span<const std::size_t> indices) {
+  for (std::size_t i : indices) MVFLOW_CHECK(i < scene.size(), "view index out of range");
+  decode_images(*scene.images, indices);
+  std::vector<PhotoView> views(indices.size());
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    const Camera& camera = scene.views[indices[k]].camera;
+    const Image& image = scene.image(indices[k]);
     MVFLOW_CHECK(image.width() == camera.width() && image.height() == camera.height(),
                  "image size differs from its camera's");
-    views[i] = {&camera, &image, camera.projection_matrix(), camera.distortion().is_identity(), camera.width(),
+    views[k] = {&camera, &image, camera.projection_matrix(), camera.distortion().is_identity(), camera.width(),
                 camera.height()};
   }
   return views;
+}
+
+std::vector<PhotoView> make_photo_views(const Scene& scene) {
+  std::vector<std::size_t> all(scene.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return make_photo_views(scene, all);
 }
 
 }  // namespace mvflow

@@ -51,5 +51,8 @@ void decode_images(const ImageStore& store, std::span<const std::size_t> indices
 //! Views of a scene, decoding its images now (decode_images).
 //! \throw what decoding throws, for the first view whose image fails.
 std::vector<PhotoView> make_photo_views(const Scene& scene);
+//! The views of \p scene with the given \p indices, in that order, decoding only their images
+//! (an excluded view's photograph is never read). \throw as make_photo_views(scene).
+std::vector<PhotoView> make_photo_views(const Scene& scene, std::span<const std::size_t> indices);
 
 }  // namespace mvflow
