@@ -32,6 +32,8 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--min-views", {"4", 4}},
       {"--image-levels", {"2", 2}},
       {"--normalize", {"on", true}},
+      {"--surface-patch", {"on", true}},
+      {"--surface-patch-spacing", {"3", 3.0}},
       {"--noise-floor", {"0.05", 0.05}},
       {"--drop-views", {"2", 2}},
       {"--drop-min-views", {"6", 6}},

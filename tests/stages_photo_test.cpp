@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -17,6 +18,8 @@
 #include "stages/flow/photo_consistency.h"
 #include "stages/flow/photo_gradient.h"
 #include "stages/flow/photo_kernel.h"
+#include "stages/flow/surface_patch.h"
+#include "engine/model/option_check.h"
 #include "stages/synth/synth_scene.h"
 #include "stages/flow/visibility.h"
 #include "photo_reference.h"
@@ -520,6 +523,50 @@ TEST(PhotoConsistency, MinimumAlongTheNormalOnARenderedObject) {
   EXPECT_GE(rising, 0.9 * vertices);
 }
 
+TEST(SurfacePatch, MinimumAlongTheNormalOnARenderedObject) {
+  // PhotoConsistency.MinimumAlongTheNormalOnARenderedObject with surface patches laid out at each
+  // truth vertex (its normal), scanned as the gradient's samples are.
+  const SphereScene& s = sphere_scene();
+  const double dx = s.shortest_edge / 40;
+  const PhotoConsistencyOptions defaults;
+  SurfacePatchLayout layout;
+  int vertices = 0, within = 0, within2 = 0, within4 = 0, rising = 0;
+  std::vector<double> offsets;
+  for (std::uint32_t v = 0; v < s.truth.n_vertices(); ++v) {
+    if (s.fields.visible_count[v] < 2) continue;
+    ++vertices;
+    const Eigen::Vector3d P = s.truth.position(v), N = s.fields.normal[v];
+    layout_surface_patch(P, N, s.fields.visible(v), s.views, 2, defaults.surface_patch_spacing, layout);
+    int best = 0;
+    double best_g = 1e300, g_low = 0, g_high = 0;
+    for (int k = -40; k <= 40; ++k) {
+      const PhotoValue value = surface_patch_consistency(P + k * dx * N, layout, s.views);
+      if (!value.defined()) continue;
+      if (value.g < best_g) best_g = value.g, best = k;
+      if (k == -40) g_low = value.g;
+      if (k == 40) g_high = value.g;
+    }
+    within += std::abs(best) <= 1;
+    within2 += std::abs(best) <= 2;
+    within4 += std::abs(best) <= 4;
+    offsets.push_back(best);
+    rising += g_low > best_g && g_high > best_g;
+  }
+  std::sort(offsets.begin(), offsets.end());
+  std::printf("[measured] rendered bumpy sphere, surface patches: minimum of g within ±Δx of the surface at %d of %d "
+              "vertices (%.1f %%), ±2Δx %.1f %%, ±4Δx %.1f %%, median offset %.0f Δx; g higher one edge away on both "
+              "sides at %.1f %%\n",
+              within, vertices, 100.0 * within / vertices, 100.0 * within2 / vertices, 100.0 * within4 / vertices,
+              offsets[offsets.size() / 2], 100.0 * rising / vertices);
+  // Measured: 98.3 % within ±Δx, 100 % within ±2Δx, median −1 Δx, 100 % rising (whole-pixel
+  // patches on the same vertices: 54.5 %, 74.6 %, −1 Δx, 100 %).
+  EXPECT_GT(vertices, 1000);
+  EXPECT_GE(within, 0.9 * vertices);
+  EXPECT_GE(within2, 0.97 * vertices);
+  EXPECT_LE(std::abs(offsets[offsets.size() / 2]), 1.0);
+  EXPECT_GE(rising, 0.95 * vertices);
+}
+
 // Fields for probe points near truth vertices: probe p sees the views of vertex source[p].
 VertexFields probe_fields(const SphereScene& s, const std::vector<std::uint32_t>& source) {
   VertexFields fields;
@@ -595,6 +642,183 @@ TEST(PhotoGradient, PointsAwayFromARenderedObject) {
               away, defined, 100.0 * away / defined);
   EXPECT_GT(defined, 1000);
   EXPECT_GE(away, 0.85 * defined);  // measured 91.2 %
+}
+
+// ---- Surface patches (stages/flow/surface_patch.h) ----
+
+// The textured plane z = 0 seen at 0°, 35°, 60° and 65° from its normal (focal 100 at distance
+// 100: one world unit per pixel of a frontal view; the 60° view foreshortens by 2).
+PlaneScene oblique_plane_scene() {
+  PlaneScene scene;
+  const double degrees = std::numbers::pi / 180;
+  const std::array<std::pair<double, double>, 4> rig{{{0.0, 0.0}, {35.0, 0.0}, {60.0, 90.0}, {65.0, 200.0}}};
+  for (const auto& [tilt, turn] : rig) {
+    const Eigen::Vector3d centre(100 * std::sin(tilt * degrees) * std::cos(turn * degrees),
+                                 100 * std::sin(tilt * degrees) * std::sin(turn * degrees), 100 * std::cos(tilt * degrees));
+    scene.cameras.push_back(look_at(centre, {0, 0, 0}, 100, 96, 96));
+    scene.all.push_back(static_cast<std::uint16_t>(scene.all.size()));
+  }
+  for (const auto& c : scene.cameras) scene.images.push_back(render_plane(c));
+  scene.views = make_photo_views(scene.cameras, pointers(scene.images));
+  return scene;
+}
+
+TEST(SurfacePatch, ObliqueViewsAgreeOnATexturedPlaneWhereWholePixelPatchesDoNot) {
+  // On the plane every view samples the same texture points: g is only the bilinear
+  // interpolation's error. The thesis's 5×5 pixel patch covers twice the surface along the 60° view's
+  // foreshortened axis, so its views disagree.
+  const PlaneScene scene = oblique_plane_scene();
+  SurfacePatchLayout layout;
+  double surface_sum = 0, image_sum = 0;
+  int points = 0, lower = 0;
+  for (double x = -8; x <= 8; x += 2.3)
+    for (double y = -8; y <= 8; y += 2.1) {
+      const Eigen::Vector3d X(x, y, 0);
+      layout_surface_patch(X, Eigen::Vector3d::UnitZ(), scene.all, scene.views, 2, 2.0, layout);
+      const PhotoValue surface = surface_patch_consistency(X, layout, scene.views);
+      const PhotoValue image = photo_consistency(X, scene.all, scene.views);
+      ASSERT_EQ(surface.views, 4);
+      ASSERT_EQ(image.views, 4);
+      surface_sum += surface.g;
+      image_sum += image.g;
+      lower += surface.g < 0.2 * image.g;
+      ++points;
+    }
+  EXPECT_LT(surface_sum, 0.1 * image_sum);
+  EXPECT_EQ(lower, points);
+  std::printf("[measured] mean g on the plane: surface patch %.3g, 5x5 pixel patch %.3g (%.1f%%)\n",
+              surface_sum / points, image_sum / points, 100 * surface_sum / image_sum);
+}
+
+TEST(SurfacePatch, MinimumAlongTheNormalIsAtTheSurface) {
+  // The patch laid out at a point of the plane and moved along the normal, as the gradient's samples move.
+  const PlaneScene scene = oblique_plane_scene();
+  SurfacePatchLayout layout;
+  const double dx = 0.1;
+  int points = 0, at_surface = 0, rising = 0;
+  for (double x = -8; x <= 8; x += 3.1)
+    for (double y = -8; y <= 8; y += 2.9) {
+      ++points;
+      const Eigen::Vector3d X(x, y, 0);
+      layout_surface_patch(X, Eigen::Vector3d::UnitZ(), scene.all, scene.views, 2, 2.0, layout);
+      double best_t = 0, best_g = 1e300;
+      for (int s = -40; s <= 40; ++s) {
+        const double g = surface_patch_consistency(X + Eigen::Vector3d(0, 0, s * dx), layout, scene.views).g;
+        if (g < best_g) best_g = g, best_t = s * dx;
+      }
+      at_surface += std::abs(best_t) <= dx + 1e-12;
+      rising += surface_patch_consistency(X + Eigen::Vector3d(0, 0, 3), layout, scene.views).g > best_g &&
+                surface_patch_consistency(X - Eigen::Vector3d(0, 0, 3), layout, scene.views).g > best_g;
+    }
+  EXPECT_GE(at_surface, 0.9 * points) << at_surface << " of " << points;
+  EXPECT_EQ(rising, points);
+}
+
+TEST(SurfacePatch, EqualsTheExactProjectionOfItsTangentPoints) {
+  // Brute force in double: the 25 tangent-plane points X + d·(a·t₁ + b·t₂), d = 2 × the smallest
+  // depth / focal, each projected by the camera and read bilinearly, the views whose points all
+  // have their 2×2 support inside the image, SPEC §3's variance.
+  const PlaneScene scene = oblique_plane_scene();
+  const Eigen::Vector3d N = Eigen::Vector3d(0.3, -0.2, 1).normalized();
+  Eigen::Vector3d t1, t2;
+  surface_patch_frame(N, t1, t2);
+  ASSERT_NEAR(t1.dot(N), 0, 1e-15);
+  ASSERT_NEAR(t2.dot(N), 0, 1e-15);
+  ASSERT_NEAR(t1.dot(t2), 0, 1e-15);
+  SurfacePatchLayout layout;
+  int compared = 0, partial = 0;
+  for (double x = -40; x <= 40; x += 4.7)
+    for (double y = -30; y <= 30; y += 5.3) {
+      const Eigen::Vector3d X(x, y, 0.5);
+      layout_surface_patch(X, N, scene.all, scene.views, 2, 2.0, layout);
+      double footprint = 1e300;
+      for (const Camera& c : scene.cameras) footprint = std::min(footprint, c.project(X).depth / c.focal_pixels());
+      std::vector<std::vector<double>> patches;
+      for (std::size_t i = 0; i < scene.cameras.size(); ++i) {
+        std::vector<double> patch;
+        bool inside = true;
+        for (int b = -2; b <= 2 && inside; ++b)
+          for (int a = -2; a <= 2 && inside; ++a) {
+            const Projection p = scene.cameras[i].project(X + 2 * footprint * (a * t1 + b * t2));
+            const int x0 = static_cast<int>(std::floor(p.u)), y0 = static_cast<int>(std::floor(p.v));
+            inside = x0 >= 0 && y0 >= 0 && x0 + 1 < 96 && y0 + 1 < 96;
+            if (!inside) break;
+            const double fx = p.u - x0, fy = p.v - y0;
+            const Image& im = scene.images[i];
+            for (int c = 0; c < 3; ++c)
+              patch.push_back((1 - fx) * (1 - fy) * im.pixel(x0, y0)[c] + fx * (1 - fy) * im.pixel(x0 + 1, y0)[c] +
+                              (1 - fx) * fy * im.pixel(x0, y0 + 1)[c] + fx * fy * im.pixel(x0 + 1, y0 + 1)[c]);
+          }
+        if (inside) patches.push_back(patch);
+      }
+      const PhotoValue value = surface_patch_consistency(X, layout, scene.views);
+      ASSERT_EQ(value.views, static_cast<int>(patches.size())) << X.transpose();
+      partial += patches.size() < scene.cameras.size();
+      if (patches.size() < 2) continue;
+      const double m = static_cast<double>(patches.size());
+      double g = 0;
+      for (std::size_t k = 0; k < 75; ++k) {
+        double mean = 0;
+        for (const auto& p : patches) mean += p[k] / m;
+        for (const auto& p : patches) g += (p[k] - mean) * (p[k] - mean) / (m - 1) / 25.0;
+      }
+      EXPECT_NEAR(value.g, g, 1e-6 + 1e-4 * g) << X.transpose();
+      ++compared;
+    }
+  EXPECT_GT(compared, 100);
+  EXPECT_GT(partial, 10);  // the border case: some views' patches leave their image
+}
+
+TEST(SurfacePatch, TheGradientStagePointsAwayFromThePlane) {
+  PhotoGradientOptions options;
+  options.photo.surface_patch = true;
+  const PhotoGradientStage stage(options);
+  const PlaneScene scene = oblique_plane_scene();
+  const double edge = 4.0;
+  Mesh mesh;
+  std::vector<double> heights;
+  for (double x = -8; x <= 8; x += 4)
+    for (double y = -8; y <= 8; y += 4)
+      for (const double t : {-1.0, -0.5, 0.5, 1.0}) {
+        mesh.topology.add_vertex(to_openmesh(Eigen::Vector3d(x, y, t * edge)));
+        heights.push_back(t);
+      }
+  VertexFields fields;
+  fields.resize(mesh.n_vertices(), scene.views.size());
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+    fields.normal[v] = Eigen::Vector3d::UnitZ();
+    fields.visible_count[v] = static_cast<std::uint16_t>(scene.all.size());
+    std::copy(scene.all.begin(), scene.all.end(), fields.visible_views.begin() + v * fields.view_capacity);
+  }
+  stage.run(mesh.topology, {0, static_cast<std::uint32_t>(mesh.n_vertices())}, scene.views, stage.sample_spacing(edge),
+            fields);
+  int away = 0;
+  SurfacePatchLayout layout;
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+    ASSERT_TRUE(fields.defined[v] & kGradientDefined);
+    away += fields.photo_gradient[v].z() * heights[v] > 0;
+    // g is the surface patch's, laid out at the vertex.
+    const Eigen::Vector3d X = to_eigen(mesh.topology.point(TriMesh::VertexHandle(static_cast<int>(v))));
+    layout_surface_patch(X, Eigen::Vector3d::UnitZ(), scene.all, scene.views, 2, options.photo.surface_patch_spacing, layout);
+    EXPECT_EQ(fields.photo_consistency[v], surface_patch_consistency(X, layout, scene.views).g);
+  }
+  // As PhotoGradient.PointsAwayFromTheSurfaceNearIt with whole-pixel patches (measured 95 of 100).
+  EXPECT_GE(away, 0.9 * static_cast<double>(mesh.n_vertices())) << away << " of " << mesh.n_vertices();
+  std::printf("[measured] surface patches: ∇g points away from the plane at %d of %zu points\n", away,
+              mesh.n_vertices());
+}
+
+TEST(SurfacePatch, OptionsOutOfRangeAreRefused) {
+  PhotoConsistencyOptions options;
+  options.surface_patch = true;
+  EXPECT_NO_THROW(options.check());
+  options.normalize = true;
+  EXPECT_THROW(options.check(), OptionError);
+  options.normalize = false;
+  for (const double spacing : {0.0, -1.0, 8.5, std::nan("")}) {
+    options.surface_patch_spacing = spacing;
+    EXPECT_THROW(options.check(), OptionError) << spacing;
+  }
 }
 
 }  // namespace

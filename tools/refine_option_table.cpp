@@ -165,6 +165,13 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(on_off("--normalize", "photo_normalize",
                      "Per-view gain/bias normalisation of the patches before the variance (on/off)",
                      [](auto& o) -> auto& { return o.photo.photo.normalize; }));
+  t.push_back(on_off("--surface-patch", "photo_surface_patch",
+                     "Patches laid on the tangent plane, the same surface points in every view, instead of whole-pixel "
+                     "image patches (on/off)",
+                     [](auto& o) -> auto& { return o.photo.photo.surface_patch; }));
+  t.push_back(value("--surface-patch-spacing", "photo_surface_patch_spacing", "photo.photo.surface_patch_spacing",
+                    "--surface-patch: spacing of the patch points in pixels of the finest view",
+                    [](auto& o) -> auto& { return o.photo.photo.surface_patch_spacing; }));
   t.push_back(value("--noise-floor", "photo_noise_floor", "photo.photo.noise_floor",
                     "Normalisation: contrast floor σ₀ on [0,1] values (flat patches are not stretched beyond it)",
                     [](auto& o) -> auto& { return o.photo.photo.noise_floor; }));

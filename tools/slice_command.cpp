@@ -22,6 +22,7 @@ struct SliceArguments {
   std::string output;
   std::string axis = "z";
   std::string views = "nearest";
+  std::string surface_patch = "off";
   bool linear = false;
   PhotoSliceOptions options;
 };
@@ -50,6 +51,7 @@ int run_slice(const SliceArguments& args, spdlog::logger& log) {
   PhotoSliceOptions options = args.options;
   options.axis = args.axis == "x" ? 0 : args.axis == "y" ? 1 : 2;
   options.views = args.views == "all" ? SliceViews::All : SliceViews::NearestVertex;
+  options.photo.surface_patch = args.surface_patch == "on";
   const PhotoSlice slice = compute_photo_slice(mesh.topology, make_photo_views(scene), options);
 
   // Colour scale: log10 g between the 2nd and 98th percentiles of the defined samples (g spans
@@ -110,6 +112,13 @@ void add_slice_command(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   command->add_option("--patch", args->options.photo.half_patch, "Patch half size (2 = 5×5)")
       ->check(CLI::Range(1, 7))
+      ->capture_default_str();
+  command->add_option("--surface-patch", args->surface_patch,
+                      "on: patches laid on the nearest vertex's tangent plane, as refine --surface-patch on")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  command->add_option("--surface-patch-spacing", args->options.photo.surface_patch_spacing,
+                      "Surface patch: spacing of its points in pixels of the finest view (valid: (0, 8])")
       ->capture_default_str();
   command->add_flag("--linear", args->linear, "Linear colour scale instead of log10");
   command->callback([args, &runner] { runner = [args](spdlog::logger& log) { return run_slice(*args, log); }; });

@@ -11,6 +11,7 @@
 #include "engine/model/parallel.h"
 #include "engine/model/surface_query.h"
 #include "stages/flow/normals.h"
+#include "stages/flow/surface_patch.h"
 
 namespace mvflow {
 
@@ -69,30 +70,42 @@ PhotoSlice compute_photo_slice(const TriMesh& mesh, const std::vector<PhotoView>
   VertexFields fields;
   std::vector<std::uint16_t> all_views(views.size());
   for (std::size_t i = 0; i < views.size(); ++i) all_views[i] = static_cast<std::uint16_t>(i);
-  if (options.views == SliceViews::NearestVertex) {
+  // The nearest vertex gives the views (NearestVertex) and the surface patch's normal.
+  const bool nearest_vertex = options.views == SliceViews::NearestVertex || options.photo.surface_patch;
+  if (nearest_vertex) {
     fields.resize(mesh.n_vertices(), views.size());
     const IndexRange everything{0, static_cast<std::uint32_t>(mesh.n_vertices())};
     compute_normals(mesh, everything, fields);
-    compute_visibility(mesh, everything, views, surface, edge_lengths(mesh).mean, options.visibility, fields);
+    if (options.views == SliceViews::NearestVertex)
+      compute_visibility(mesh, everything, views, surface, edge_lengths(mesh).mean, options.visibility, fields);
   }
 
   parallel::parallel_for(0, slice.height, [&](int j) {
+    SurfacePatchLayout layout;
     for (int i = 0; i < slice.width; ++i) {
       const Eigen::Vector3d X = slice.point(i, j);
       std::span<const std::uint16_t> used(all_views);
-      if (options.views == SliceViews::NearestVertex) {
+      std::uint32_t best = 0;
+      if (nearest_vertex) {
         // The nearest corner of the nearest face stands in for the nearest vertex.
         const ClosestPoint nearest = surface.closest_point(X);
-        std::uint32_t best = 0;
         double best_distance = std::numeric_limits<double>::infinity();
         for (auto v : mesh.fv_range(TriMesh::FaceHandle(static_cast<int>(nearest.face)))) {
           const double d = (to_eigen(mesh.point(v)) - X).squaredNorm();
           if (d < best_distance) best_distance = d, best = static_cast<std::uint32_t>(v.idx());
         }
+      }
+      if (options.views == SliceViews::NearestVertex)
         used = std::span<const std::uint16_t>(fields.visible_views.data() + best * fields.view_capacity,
                                               fields.visible_count[best]);
+      PhotoValue value;
+      if (options.photo.surface_patch) {
+        layout_surface_patch(X, fields.normal[best], used, views, options.photo.half_patch,
+                             options.photo.surface_patch_spacing, layout);
+        value = surface_patch_consistency(X, layout, views);
+      } else {
+        value = photo_consistency(X, used, views, options.photo);
       }
-      const PhotoValue value = photo_consistency(X, used, views, options.photo);
       if (value.defined()) slice.g[static_cast<std::size_t>(j) * slice.width + i] = value.g;
     }
   });

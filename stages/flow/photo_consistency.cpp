@@ -8,6 +8,7 @@
 #include "engine/model/option_check.h"
 #include "stages/flow/photo_kernel.h"
 #include "stages/flow/photo_robust.h"
+#include "stages/flow/surface_patch.h"
 
 namespace mvflow {
 
@@ -16,6 +17,9 @@ void PhotoConsistencyOptions::check() const {
   require_option(noise_floor >= 0 && noise_floor <= 1, "noise_floor", noise_floor, "[0, 1]");
   require_option(drop_views >= 0 && drop_views <= 64, "drop_views", drop_views, "[0, 64]");
   require_option(min_views >= 2 && min_views <= 1000, "min_views", min_views, "[2, 1000]");
+  require_option(surface_patch_spacing > 0 && surface_patch_spacing <= 8, "surface_patch_spacing",
+                 surface_patch_spacing, "(0, 8]");
+  require_option(!(surface_patch && normalize), "surface_patch", surface_patch, "off when normalize is on");
 }
 
 namespace detail {
@@ -100,9 +104,17 @@ PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint
 void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
                                const PhotoConsistencyOptions& options, VertexFields& fields) {
   options.check();
+  SurfacePatchLayout layout;
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
-    const PhotoValue value = photo_consistency(to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))),
-                                               fields.visible(v), views, options);
+    const Eigen::Vector3d X = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
+    PhotoValue value;
+    if (options.surface_patch) {
+      layout_surface_patch(X, fields.normal[v], fields.visible(v), views, options.half_patch,
+                           options.surface_patch_spacing, layout);
+      value = surface_patch_consistency(X, layout, views);
+    } else {
+      value = photo_consistency(X, fields.visible(v), views, options);
+    }
     fields.photo_consistency[v] = value.defined() ? value.g : 0.0;
     if (value.defined())
       fields.defined[v] |= kPhotoDefined;

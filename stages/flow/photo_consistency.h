@@ -33,6 +33,14 @@ struct PhotoConsistencyOptions {
   //! while more than min_views remain; 0 keeps every view (the thesis).
   int drop_views = 0;
   int min_views = 4;  //!< views kept at least when dropping outliers (≥ 2)
+  //! Patches laid on the vertex's tangent plane, the same surface points in every view
+  //! (stages/flow/surface_patch.h), instead of the thesis's whole-pixel image patches. Needs the
+  //! vertex normal; not with normalize.
+  bool surface_patch = false;
+  //! Surface patch: the spacing of its points in pixels of the finest view (> 0, ≤ 8). 1.5 (the
+  //! 5×5 points span 6 pixels of a frontal view): 1 was better on the photographs and worse on the
+  //! synthetic scenes, 2 the reverse (README, "Surface patches").
+  double surface_patch_spacing = 1.5;
   //! \throw OptionError naming the first field out of range, its value and its valid values.
   void check() const;
 };
@@ -73,7 +81,8 @@ class PatchVariance {
 
 }  // namespace detail
 
-//! g(X) over the views \p view_ids of \p views.
+//! g(X) over the views \p view_ids of \p views, with whole-pixel image patches: the surface patch
+//! (options.surface_patch) needs the surface's normal, surface_patch_consistency() takes it.
 PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                              const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options = {});
 

@@ -6,6 +6,7 @@
 #include "engine/model/option_check.h"
 #include "stages/flow/photo_kernel.h"
 #include "stages/flow/photo_robust.h"
+#include "stages/flow/surface_patch.h"
 
 namespace mvflow {
 
@@ -26,10 +27,11 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
   MVFLOW_CHECK(sample_spacing > 0, "photo gradient: sample spacing must be positive");
   const int half = options_.savitzky_golay.half_window();
   const PhotoConsistencyOptions& photo = options_.photo;
-  const bool default_patch = photo.half_patch == 2 && !photo.normalize;
+  const bool default_patch = photo.half_patch == 2 && !photo.normalize && !photo.surface_patch;
   // Buffers for the whole block: no allocation per vertex.
   std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
   std::vector<ViewGainBias> maps;  // with normalisation, one per visible view
+  SurfacePatchLayout layout;       // with surface patches
   const auto position = [&](std::uint32_t v) { return to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))); };
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     const std::span<const std::uint16_t> visible = fields.visible(v);
@@ -45,6 +47,12 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     // shared by the axes).
     if (default_patch) {
       detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
+    } else if (photo.surface_patch) {
+      layout_surface_patch(X, fields.normal[v], visible, views, photo.half_patch, photo.surface_patch_spacing, layout);
+      for_each_gradient_sample(X, sample_spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
+        samples[slot] = surface_patch_consistency(point, layout, views);
+        return samples[0].defined();
+      });
     } else if (photo.normalize) {
       // One map per view, taken at X, for every sample: g stays smooth along the sample lines.
       gain_bias_at(X, visible, views, photo.half_patch, photo.noise_floor, maps);

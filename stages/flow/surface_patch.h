@@ -1,0 +1,48 @@
+#pragma once
+// g with patches laid on the surface instead of the image (PhotoConsistencyOptions::surface_patch).
+// The thesis's patch is (2h+1)² whole pixels around the projection in every view, so a view at an
+// angle θ to the normal covers 1/cos θ more surface along its foreshortened axis than a frontal one,
+// and on a curved surface the views' patches then disagree even at the true surface. Here every view
+// samples the same (2h+1)² points of the vertex's tangent plane, spaced by a multiple of the finest
+// visible view's pixel footprint: a grazing view reads them closer together along its
+// foreshortened axis (bilinear, at any spacing).
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "stages/flow/photo_consistency.h"
+#include "stages/flow/photo_views.h"
+
+namespace mvflow {
+
+//! Where the surface patch of one vertex falls in each of its views: per view the pixel offsets of
+//! the (2h+1)² tangent-plane points from the projection of the vertex, rows of the tangent grid
+//! in order. Laid out once per vertex; the gradient's samples (within e_min/2 of the vertex) reuse
+//! it, shifted with their own projection.
+struct SurfacePatchLayout {
+  int half_patch = 2;
+  std::vector<std::uint16_t> views;  //!< the views laid out (those with the vertex in front)
+  std::vector<float> offsets;        //!< per laid-out view, (2h+1)² pairs (du, dv)
+};
+
+//! The tangent frame of the patch: unit t₁ = N × (x or y axis, whichever is farther from N),
+//! t₂ = N × t₁.
+void surface_patch_frame(const Eigen::Vector3d& N, Eigen::Vector3d& t1, Eigen::Vector3d& t2);
+
+//! Lays out the surface patch of the point \p X with outward unit normal \p N over \p view_ids:
+//! points X + d·(a·t₁ + b·t₂), a, b = −h..h, with (t₁, t₂) a tangent frame and d
+//! \p spacing_in_pixels times the smallest depth / focal length over the views with X in front.
+void layout_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, std::span<const std::uint16_t> view_ids,
+                          const std::vector<PhotoView>& views, int half_patch, double spacing_in_pixels,
+                          SurfacePatchLayout& layout);
+
+//! g at \p X (near the laid-out point) with the laid-out patch: the same variance as
+//! photo_consistency() over the patch's bilinear samples; a view whose patch leaves the image
+//! (with its bilinear support) does not count.
+PhotoValue surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
+                                     const std::vector<PhotoView>& views);
+
+}  // namespace mvflow
