@@ -19,6 +19,7 @@ void layout_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, st
   layout.half_patch = half_patch;
   layout.views.clear();
   layout.offsets.clear();
+  layout.bounds.clear();
   // The spacing: spacing_in_pixels sides of the finest visible view's pixel at X (its footprint
   // on a surface facing it).
   double spacing = std::numeric_limits<double>::infinity();
@@ -34,13 +35,26 @@ void layout_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, st
     const PhotoView& view = views[id];
     const Projection centre = view.project(X);
     if (!(centre.depth > 0)) continue;
-    layout.views.push_back(id);
+    const std::size_t first = layout.offsets.size();
+    float bounds[4] = {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                       std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
+    bool finite = true;
     for (int b = -half_patch; b <= half_patch; ++b)
       for (int a = -half_patch; a <= half_patch; ++a) {
         const Projection p = view.project(X + spacing * (a * t1 + b * t2));
-        layout.offsets.push_back(static_cast<float>(p.u - centre.u));
-        layout.offsets.push_back(static_cast<float>(p.v - centre.v));
+        const float du = static_cast<float>(p.u - centre.u), dv = static_cast<float>(p.v - centre.v);
+        finite = finite && std::isfinite(du) && std::isfinite(dv);
+        layout.offsets.push_back(du);
+        layout.offsets.push_back(dv);
+        bounds[0] = std::min(bounds[0], du), bounds[1] = std::max(bounds[1], du);
+        bounds[2] = std::min(bounds[2], dv), bounds[3] = std::max(bounds[3], dv);
       }
+    if (!finite) {
+      layout.offsets.resize(first);
+      continue;
+    }
+    layout.views.push_back(id);
+    layout.bounds.insert(layout.bounds.end(), bounds, bounds + 4);
   }
 }
 
@@ -68,27 +82,25 @@ PhotoValue surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatc
   std::fill_n(sum, count, 0.0);
   std::fill_n(squares, count, 0.0);
   float patch[detail::kMaxPatchValues + 1];  // + 1: the last point's fourth lane
-  double u[detail::kMaxPatchValues / 3], v[detail::kMaxPatchValues / 3];
   int used = 0;
   for (std::size_t k = 0; k < layout.views.size(); ++k) {
     const PhotoView& view = views[layout.views[k]];
     const Projection centre = view.project(X);
     if (!(centre.depth > 0)) continue;
     const float* offset = layout.offsets.data() + k * 2 * static_cast<std::size_t>(points);
-    // Every point with its 2×2 support inside the image: 0 ≤ u < W − 1, 0 ≤ v < H − 1.
-    bool inside = true;
-    for (int i = 0; i < points; ++i) {
-      u[i] = centre.u + offset[2 * i];
-      v[i] = centre.v + offset[2 * i + 1];
-      inside &= u[i] >= 0 && v[i] >= 0 && u[i] < view.width - 1 && v[i] < view.height - 1;
-    }
-    if (!inside) continue;
+    // Every point with its 2×2 support inside the image, 0 ≤ u < W − 1 and 0 ≤ v < H − 1, tested
+    // on the offsets' bounds: rounding is monotone, so min_i (u + du_i) is u + min_i du_i exactly.
+    const float* bounds = layout.bounds.data() + 4 * k;
+    if (!(centre.u + bounds[0] >= 0 && centre.u + bounds[1] < view.width - 1 && centre.v + bounds[2] >= 0 &&
+          centre.v + bounds[3] < view.height - 1))
+      continue;
     const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
     const float* image = view.image->data();
     const float* last_float = image + stride * static_cast<std::size_t>(view.height) - 1;
     for (int i = 0; i < points; ++i) {
-      const int x0 = static_cast<int>(u[i]), y0 = static_cast<int>(v[i]);  // ≥ 0: the floor
-      const float fx = static_cast<float>(u[i] - x0), fy = static_cast<float>(v[i] - y0);
+      const double u = centre.u + offset[2 * i], v = centre.v + offset[2 * i + 1];
+      const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);  // ≥ 0: the floor
+      const float fx = static_cast<float>(u - x0), fy = static_cast<float>(v - y0);
       const float* top = image + static_cast<std::size_t>(y0) * stride + static_cast<std::size_t>(x0) * 3;
       const float* bottom = top + stride;
       if (bottom + 6 > last_float) {  // the 4-wide read of the image's last pixel would leave it

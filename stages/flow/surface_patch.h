@@ -26,6 +26,7 @@ struct SurfacePatchLayout {
   int half_patch = 2;
   std::vector<std::uint16_t> views;  //!< the views laid out (those with the vertex in front)
   std::vector<float> offsets;        //!< per laid-out view, (2h+1)² pairs (du, dv)
+  std::vector<float> bounds;         //!< per laid-out view: the offsets' smallest du, largest du, smallest dv, largest dv
 };
 
 //! The tangent frame of the patch: unit t₁ = N × (x or y axis, whichever is farther from N),
@@ -35,6 +36,7 @@ void surface_patch_frame(const Eigen::Vector3d& N, Eigen::Vector3d& t1, Eigen::V
 //! Lays out the surface patch of the point \p X with outward unit normal \p N over \p view_ids:
 //! points X + d·(a·t₁ + b·t₂), a, b = −h..h, with (t₁, t₂) a tangent frame and d
 //! \p spacing_in_pixels times the smallest depth / focal length over the views with X in front.
+//! A view with X behind it, or where a point does not project (e.g. N undefined), is left out.
 void layout_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, std::span<const std::uint16_t> view_ids,
                           const std::vector<PhotoView>& views, int half_patch, double spacing_in_pixels,
                           SurfacePatchLayout& layout);
