@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <random>
@@ -479,92 +481,92 @@ TEST(PhotoConsistency, EqualsSlowReferenceOnARenderedObject) {
               "(%d points, smallest g %.2g)\n", worst, compared, smallest);
 }
 
-TEST(PhotoConsistency, MinimumAlongTheNormalOnARenderedObject) {
-  // For every truth vertex seen by ≥ 2 views: scan g along its normal over ±1 shortest edge in
-  // steps of Δx = e_min/40 with the vertex's own views; where is the minimum?
-  const SphereScene& s = sphere_scene();
-  const double dx = s.shortest_edge / 40;
+// Where the minimum of g lies along the normal of every truth vertex seen by ≥ 2 views: g scanned
+// over ±1 shortest edge in steps of Δx = e_min/40. \p g_along(v, P, N, k·Δx·N) gives g at
+// P + k·Δx·N for vertex v (called for k = −40..40 in order).
+struct MinimumScan {
   int vertices = 0, within = 0, within2 = 0, within4 = 0, rising = 0;
+  double median_offset = 0;  // in Δx
+  void print(const char* what) const {
+    std::printf("[measured] rendered bumpy sphere%s: minimum of g within ±Δx of the surface at %d of %d vertices "
+                "(%.1f %%), ±2Δx %.1f %%, ±4Δx %.1f %%, median offset %.0f Δx; g higher one edge away on both "
+                "sides at %.1f %%\n",
+                what, within, vertices, 100.0 * within / vertices, 100.0 * within2 / vertices,
+                100.0 * within4 / vertices, median_offset, 100.0 * rising / vertices);
+  }
+};
+
+template <class GAlong>
+MinimumScan scan_minimum_along_normals(const SphereScene& s, GAlong g_along) {
+  const double dx = s.shortest_edge / 40;
+  MinimumScan scan;
   std::vector<double> offsets;
   for (std::uint32_t v = 0; v < s.truth.n_vertices(); ++v) {
     if (s.fields.visible_count[v] < 2) continue;
-    ++vertices;
-    const std::span<const std::uint16_t> visible = s.fields.visible(v);
+    ++scan.vertices;
     const Eigen::Vector3d P = s.truth.position(v), N = s.fields.normal[v];
     int best = 0;
     double best_g = 1e300, g_low = 0, g_high = 0;
     for (int k = -40; k <= 40; ++k) {
-      const PhotoValue value = photo_consistency(P + k * dx * N, visible, s.views);
+      const PhotoValue value = g_along(v, P, N, P + k * dx * N);
       if (!value.defined()) continue;
       if (value.g < best_g) best_g = value.g, best = k;
       if (k == -40) g_low = value.g;
       if (k == 40) g_high = value.g;
     }
-    within += std::abs(best) <= 1;
-    within2 += std::abs(best) <= 2;
-    within4 += std::abs(best) <= 4;
+    scan.within += std::abs(best) <= 1;
+    scan.within2 += std::abs(best) <= 2;
+    scan.within4 += std::abs(best) <= 4;
     offsets.push_back(best);
-    rising += g_low > best_g && g_high > best_g;
+    scan.rising += g_low > best_g && g_high > best_g;
   }
   std::sort(offsets.begin(), offsets.end());
-  std::printf("[measured] rendered bumpy sphere: minimum of g within ±Δx of the surface at %d of %d vertices "
-              "(%.1f %%), ±2Δx %.1f %%, ±4Δx %.1f %%, median offset %.0f Δx; g higher one edge away on both "
-              "sides at %.1f %%\n",
-              within, vertices, 100.0 * within / vertices, 100.0 * within2 / vertices, 100.0 * within4 / vertices,
-              offsets[offsets.size() / 2], 100.0 * rising / vertices);
+  if (!offsets.empty()) scan.median_offset = offsets[offsets.size() / 2];
+  return scan;
+}
+
+TEST(PhotoConsistency, MinimumAlongTheNormalOnARenderedObject) {
+  // For every truth vertex seen by ≥ 2 views, with the vertex's own views: where is the minimum?
+  const SphereScene& s = sphere_scene();
+  const MinimumScan scan = scan_minimum_along_normals(
+      s, [&](std::uint32_t v, const Eigen::Vector3d&, const Eigen::Vector3d&, const Eigen::Vector3d& X) {
+        return photo_consistency(X, s.fields.visible(v), s.views);
+      });
+  scan.print("");
   // Measured: 54.5 % within ±Δx, 74.6 % within ±2Δx, 91.2 % within ±4Δx, median −1 Δx, 100 %
   // rising; Δx = e_min/40 is about 0.14 pixel in these 320×240 images, so ±Δx asks for
   // sub-pixel agreement.
-  EXPECT_GT(vertices, 1000);
-  EXPECT_GE(within, 0.45 * vertices);
-  EXPECT_GE(within2, 0.65 * vertices);
-  EXPECT_GE(within4, 0.85 * vertices);
-  EXPECT_LE(std::abs(offsets[offsets.size() / 2]), 1.0);
-  EXPECT_GE(rising, 0.9 * vertices);
+  EXPECT_GT(scan.vertices, 1000);
+  EXPECT_GE(scan.within, 0.45 * scan.vertices);
+  EXPECT_GE(scan.within2, 0.65 * scan.vertices);
+  EXPECT_GE(scan.within4, 0.85 * scan.vertices);
+  EXPECT_LE(std::abs(scan.median_offset), 1.0);
+  EXPECT_GE(scan.rising, 0.9 * scan.vertices);
 }
 
 TEST(SurfacePatch, MinimumAlongTheNormalOnARenderedObject) {
-  // PhotoConsistency.MinimumAlongTheNormalOnARenderedObject with surface patches laid out at each
-  // truth vertex (its normal), scanned as the gradient's samples are.
+  // The same scan with surface patches laid out at each truth vertex (its normal), moved along the
+  // normal as the gradient's samples move it.
   const SphereScene& s = sphere_scene();
-  const double dx = s.shortest_edge / 40;
   const PhotoConsistencyOptions defaults;
   SurfacePatchLayout layout;
-  int vertices = 0, within = 0, within2 = 0, within4 = 0, rising = 0;
-  std::vector<double> offsets;
-  for (std::uint32_t v = 0; v < s.truth.n_vertices(); ++v) {
-    if (s.fields.visible_count[v] < 2) continue;
-    ++vertices;
-    const Eigen::Vector3d P = s.truth.position(v), N = s.fields.normal[v];
-    layout_surface_patch(P, N, s.fields.visible(v), s.views, 2, defaults.surface_patch_spacing, layout);
-    int best = 0;
-    double best_g = 1e300, g_low = 0, g_high = 0;
-    for (int k = -40; k <= 40; ++k) {
-      const PhotoValue value = surface_patch_consistency(P + k * dx * N, layout, s.views);
-      if (!value.defined()) continue;
-      if (value.g < best_g) best_g = value.g, best = k;
-      if (k == -40) g_low = value.g;
-      if (k == 40) g_high = value.g;
-    }
-    within += std::abs(best) <= 1;
-    within2 += std::abs(best) <= 2;
-    within4 += std::abs(best) <= 4;
-    offsets.push_back(best);
-    rising += g_low > best_g && g_high > best_g;
-  }
-  std::sort(offsets.begin(), offsets.end());
-  std::printf("[measured] rendered bumpy sphere, surface patches: minimum of g within ±Δx of the surface at %d of %d "
-              "vertices (%.1f %%), ±2Δx %.1f %%, ±4Δx %.1f %%, median offset %.0f Δx; g higher one edge away on both "
-              "sides at %.1f %%\n",
-              within, vertices, 100.0 * within / vertices, 100.0 * within2 / vertices, 100.0 * within4 / vertices,
-              offsets[offsets.size() / 2], 100.0 * rising / vertices);
+  std::uint32_t laid_out = std::numeric_limits<std::uint32_t>::max();
+  const MinimumScan scan = scan_minimum_along_normals(
+      s, [&](std::uint32_t v, const Eigen::Vector3d& P, const Eigen::Vector3d& N, const Eigen::Vector3d& X) {
+        if (v != laid_out) {
+          layout_surface_patch(P, N, s.fields.visible(v), s.views, 2, defaults.surface_patch_spacing, layout);
+          laid_out = v;
+        }
+        return surface_patch_consistency(X, layout, s.views);
+      });
+  scan.print(", surface patches");
   // Measured: 98.3 % within ±Δx, 100 % within ±2Δx, median −1 Δx, 100 % rising (whole-pixel
   // patches on the same vertices: 54.5 %, 74.6 %, −1 Δx, 100 %).
-  EXPECT_GT(vertices, 1000);
-  EXPECT_GE(within, 0.9 * vertices);
-  EXPECT_GE(within2, 0.97 * vertices);
-  EXPECT_LE(std::abs(offsets[offsets.size() / 2]), 1.0);
-  EXPECT_GE(rising, 0.95 * vertices);
+  EXPECT_GT(scan.vertices, 1000);
+  EXPECT_GE(scan.within, 0.9 * scan.vertices);
+  EXPECT_GE(scan.within2, 0.97 * scan.vertices);
+  EXPECT_LE(std::abs(scan.median_offset), 1.0);
+  EXPECT_GE(scan.rising, 0.95 * scan.vertices);
 }
 
 // Fields for probe points near truth vertices: probe p sees the views of vertex source[p].

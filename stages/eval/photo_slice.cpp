@@ -98,14 +98,9 @@ PhotoSlice compute_photo_slice(const TriMesh& mesh, const std::vector<PhotoView>
       if (options.views == SliceViews::NearestVertex)
         used = std::span<const std::uint16_t>(fields.visible_views.data() + best * fields.view_capacity,
                                               fields.visible_count[best]);
-      PhotoValue value;
-      if (options.photo.surface_patch) {
-        layout_surface_patch(X, fields.normal[best], used, views, options.photo.half_patch,
-                             options.photo.surface_patch_spacing, layout);
-        value = surface_patch_consistency(X, layout, views);
-      } else {
-        value = photo_consistency(X, used, views, options.photo);
-      }
+      // fields.normal is sized only when a nearest vertex was looked for.
+      const Eigen::Vector3d normal = nearest_vertex ? fields.normal[best] : Eigen::Vector3d::Zero();
+      const PhotoValue value = photo_consistency_at_surface(X, normal, used, views, options.photo, layout);
       if (value.defined()) slice.g[static_cast<std::size_t>(j) * slice.width + i] = value.g;
     }
   });

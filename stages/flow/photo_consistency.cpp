@@ -107,14 +107,7 @@ void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const s
   SurfacePatchLayout layout;
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     const Eigen::Vector3d X = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
-    PhotoValue value;
-    if (options.surface_patch) {
-      layout_surface_patch(X, fields.normal[v], fields.visible(v), views, options.half_patch,
-                           options.surface_patch_spacing, layout);
-      value = surface_patch_consistency(X, layout, views);
-    } else {
-      value = photo_consistency(X, fields.visible(v), views, options);
-    }
+    const PhotoValue value = photo_consistency_at_surface(X, fields.normal[v], fields.visible(v), views, options, layout);
     fields.photo_consistency[v] = value.defined() ? value.g : 0.0;
     if (value.defined())
       fields.defined[v] |= kPhotoDefined;

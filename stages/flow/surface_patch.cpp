@@ -134,4 +134,12 @@ PhotoValue surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatc
   return result;
 }
 
+PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
+                                        std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
+                                        const PhotoConsistencyOptions& options, SurfacePatchLayout& layout) {
+  if (!options.surface_patch) return photo_consistency(X, view_ids, views, options);
+  layout_surface_patch(X, N, view_ids, views, options.half_patch, options.surface_patch_spacing, layout);
+  return surface_patch_consistency(X, layout, views);
+}
+
 }  // namespace mvflow

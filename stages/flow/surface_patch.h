@@ -47,4 +47,11 @@ void layout_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, st
 PhotoValue surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
                                      const std::vector<PhotoView>& views);
 
+//! g at the surface point \p X with outward unit normal \p N as the options say: the surface
+//! patch (laid out in \p layout, reused between calls) when options.surface_patch, else
+//! photo_consistency().
+PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
+                                        std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
+                                        const PhotoConsistencyOptions& options, SurfacePatchLayout& layout);
+
 }  // namespace mvflow
