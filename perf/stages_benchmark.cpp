@@ -164,6 +164,24 @@ void BM_PhotoGradient(benchmark::State& state) {
 }
 BENCHMARK(BM_PhotoGradient)->Unit(benchmark::kMillisecond);
 
+// The same stage with surface patches (PhotoConsistencyOptions::surface_patch): every view reads
+// the (2h+1)² tangent-plane points bilinearly, one 2×2-pixel support per point.
+void BM_PhotoGradientSurfacePatch(benchmark::State& state) {
+  const StageScene& s = scene();
+  VertexFields fields = visible_fields();
+  PhotoGradientOptions options;
+  options.photo.surface_patch = true;
+  const PhotoGradientStage stage(options);
+  const double evaluations = 3.0 * stage.options().savitzky_golay.k + 1;
+  const double spacing = sample_spacing();
+  for (auto _ : state) stage.run(s.mesh(), s.everything(), s.views, spacing, fields);
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
+  state.counters["g_evaluations/s"] = benchmark::Counter(
+      evaluations * static_cast<double>(s.n_vertices()) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.SetLabel("61 evaluations of g per vertex, surface patches");
+}
+BENCHMARK(BM_PhotoGradientSurfacePatch)->Unit(benchmark::kMillisecond);
+
 // The bound for BM_PhotoGradient's patch_pixel_reads/s: its reads without its arithmetic.
 void BM_PatchGatherBound(benchmark::State& state) {
   const auto& blocks = gradient_blocks();

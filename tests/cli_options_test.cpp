@@ -95,6 +95,19 @@ TEST(RefineOptionTable, FlagsAndReportKeysAreDeclaredOnce) {
   EXPECT_EQ(json.size(), keys.size() + 1);  // and "preset"
 }
 
+TEST(RefinePresets, AccurateIsTheDefaultWithSurfacePatchesAndTheFinerSettledTolerance) {
+  const nlohmann::json accurate = refine_options_json(preset("accurate"), "accurate");
+  const nlohmann::json plain = refine_options_json(preset("default"), "default");
+  std::set<std::string> differing;
+  for (const auto& [key, value] : plain.items())
+    if (accurate.at(key) != value) differing.insert(key);
+  EXPECT_EQ(differing, (std::set<std::string>{"preset", "photo_surface_patch", "settled_tolerance"}));
+  EXPECT_EQ(accurate.at("photo_surface_patch"), true);
+  EXPECT_EQ(accurate.at("settled_tolerance"), 0.001);
+  preset("accurate").check();
+  EXPECT_THROW(preset("fast"), InputError);
+}
+
 TEST(RefineOptionTable, EveryEntryIsCovered) {
   EXPECT_EQ(cases().size(), refine_option_table().size());
   for (const RefineOptionEntry& entry : refine_option_table())

@@ -10,6 +10,7 @@
 #include "engine/model/image.h"
 #include "stages/flow/photo_consistency.h"
 #include "stages/flow/photo_gradient.h"
+#include "stages/flow/surface_patch.h"
 
 namespace mvflow::test {
 
@@ -58,21 +59,80 @@ inline PhotoValue slow_photo_consistency(const Eigen::Vector3d& X, const std::ve
   return result;
 }
 
-//! ∇g at \p X by \p stage's Savitzky–Golay sum over the slow reference at its samples, spaced \p dx.
-inline Eigen::Vector3d slow_photo_gradient(const PhotoGradientStage& stage, const Eigen::Vector3d& X, double dx,
-                                           const std::vector<Camera>& cameras, const std::vector<Image>& images,
-                                           const std::vector<std::uint16_t>& ids) {
+//! ∇g at \p X by \p stage's Savitzky–Golay sum over \p g_at (a point → g) at its samples, spaced \p dx.
+template <typename GAt>
+Eigen::Vector3d savitzky_golay_gradient(const PhotoGradientStage& stage, const Eigen::Vector3d& X, double dx,
+                                        GAt g_at) {
   Eigen::Vector3d gradient;
   for (int axis = 0; axis < 3; ++axis) {
     double derivative = 0;
     for (int k = -10; k <= 10; ++k) {
       Eigen::Vector3d sample = X;
       sample[axis] += k * dx;
-      derivative += stage.coefficients()[k + 10] * slow_photo_consistency(sample, cameras, images, ids).g;
+      derivative += stage.coefficients()[k + 10] * g_at(sample);
     }
     gradient[axis] = derivative / dx;
   }
   return gradient;
+}
+
+//! ∇g at \p X by \p stage's Savitzky–Golay sum over the slow reference at its samples, spaced \p dx.
+inline Eigen::Vector3d slow_photo_gradient(const PhotoGradientStage& stage, const Eigen::Vector3d& X, double dx,
+                                           const std::vector<Camera>& cameras, const std::vector<Image>& images,
+                                           const std::vector<std::uint16_t>& ids) {
+  return savitzky_golay_gradient(stage, X, dx, [&](const Eigen::Vector3d& sample) {
+    return slow_photo_consistency(sample, cameras, images, ids).g;
+  });
+}
+
+// The slow reference of the surface patch at X with the laid-out patch: per laid-out view, X
+// projected by its camera, each point at that projection plus its layout offset, read bilinearly
+// in double; a view counts when every point's 2×2 support lies in the image; variances by the
+// two-pass formula.
+inline PhotoValue slow_surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
+                                                 const std::vector<Camera>& cameras, const std::vector<Image>& images) {
+  std::vector<std::vector<double>> patches;
+  for (std::size_t k = 0; k < layout.views.size(); ++k) {
+    const std::uint16_t id = layout.views[k];
+    const Projection centre = cameras[id].project(X);
+    if (!(centre.depth > 0)) continue;
+    const int W = cameras[id].width(), H = cameras[id].height();
+    std::vector<double> patch;
+    bool inside = true;
+    for (int i = 0; i < layout.points && inside; ++i) {
+      const std::size_t e = k * static_cast<std::size_t>(layout.padded_points) + static_cast<std::size_t>(i);
+      const double u = centre.u + layout.du[e], v = centre.v + layout.dv[e];
+      const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
+      inside = x0 >= 0 && y0 >= 0 && x0 + 1 <= W - 1 && y0 + 1 <= H - 1;
+      if (!inside) break;
+      const double a = u - x0, b = v - y0;
+      for (int c = 0; c < 3; ++c)
+        patch.push_back((1 - a) * (1 - b) * images[id].pixel(x0, y0)[c] + a * (1 - b) * images[id].pixel(x0 + 1, y0)[c] +
+                        (1 - a) * b * images[id].pixel(x0, y0 + 1)[c] + a * b * images[id].pixel(x0 + 1, y0 + 1)[c]);
+    }
+    if (inside) patches.push_back(patch);
+  }
+  PhotoValue result;
+  result.views = static_cast<int>(patches.size());
+  if (patches.size() < 2) return result;
+  const double m = static_cast<double>(patches.size());
+  double g = 0;
+  for (std::size_t k = 0; k < patches.front().size(); ++k) {
+    double mean = 0;
+    for (const auto& p : patches) mean += p[k] / m;
+    for (const auto& p : patches) g += (p[k] - mean) * (p[k] - mean) / (m - 1) / layout.points;
+  }
+  result.g = g;
+  return result;
+}
+
+//! ∇g at \p X as slow_photo_gradient, over slow_surface_patch_consistency with \p layout.
+inline Eigen::Vector3d slow_surface_patch_gradient(const PhotoGradientStage& stage, const Eigen::Vector3d& X, double dx,
+                                                   const SurfacePatchLayout& layout, const std::vector<Camera>& cameras,
+                                                   const std::vector<Image>& images) {
+  return savitzky_golay_gradient(stage, X, dx, [&](const Eigen::Vector3d& sample) {
+    return slow_surface_patch_consistency(sample, layout, cameras, images).g;
+  });
 }
 
 }  // namespace mvflow::test

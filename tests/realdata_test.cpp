@@ -15,6 +15,7 @@
 #include "io/scene_io.h"
 #include "photo_reference.h"
 #include "stages/flow/photo_views.h"
+#include "stages/flow/surface_patch.h"
 #include "test_support.h"
 
 namespace mvflow {
@@ -77,6 +78,8 @@ TEST(RealData, RefiningTheTempleHullLowersItsHeldOutViewError) {
 // where the views agree to large across the outline), each with the views within 60° of its
 // normal, g within 1e-5 relative of the double-precision reference; and ∇g (the stage's 61
 // samples) within 1e-4 relative of the Savitzky–Golay sum over the reference at 40 of them.
+// Both for the 5×5 pixel patch and for surface patches (the same laid-out points, read and summed
+// in double).
 void expect_reference_accuracy_on_photographs(const std::string& set) {
   const std::filesystem::path scene_path = std::filesystem::path(MVFLOW_SHARED_DATA) / set;
   if (!std::filesystem::exists(scene_path)) GTEST_SKIP() << set << " is not in " << MVFLOW_SHARED_DATA;
@@ -103,9 +106,14 @@ void expect_reference_accuracy_on_photographs(const std::string& set) {
     shortest_edge = std::min({shortest_edge, (b - a).norm(), (c - b).norm(), (a - c).norm()});
   }
   const PhotoGradientStage stage;
+  PhotoGradientOptions surface_options;
+  surface_options.photo.surface_patch = true;
+  const PhotoGradientStage surface_stage(surface_options);
   const double dx = stage.sample_spacing(shortest_edge);
   double worst_g = 0, worst_gradient = 0, smallest_g = 1e300;
-  int compared = 0, gradients = 0;
+  double worst_surface_g = 0, worst_surface_gradient = 0;
+  int compared = 0, gradients = 0, surface_compared = 0, surface_gradients = 0;
+  SurfacePatchLayout layout;
   for (std::size_t v = 0; v < hull.positions.size(); v += 7) {
     const Eigen::Vector3d N = normals[v].normalized(), P = hull.positions[v];
     std::vector<std::uint16_t> facing;
@@ -122,6 +130,17 @@ void expect_reference_accuracy_on_photographs(const std::string& set) {
       worst_g = std::max(worst_g, std::abs(fast.g - slow.g) / slow.g);
       smallest_g = std::min(smallest_g, slow.g);
     }
+    layout_surface_patch(P, N, facing, views, 2, surface_options.photo.surface_patch_spacing, layout);
+    for (const double t : {-0.5, 0.0, 0.5}) {
+      const Eigen::Vector3d X = P + t * shortest_edge * N;
+      const PhotoValue slow = test::slow_surface_patch_consistency(X, layout, cameras, images);
+      const PhotoValue fast = surface_patch_consistency(X, layout, views);
+      ASSERT_EQ(fast.views, slow.views) << set << " vertex " << v << ", surface patch";
+      if (!slow.defined() || slow.g == 0) continue;
+      ++surface_compared;
+      EXPECT_NEAR(fast.g, slow.g, 1e-5 * slow.g) << set << " vertex " << v << ", surface patch";
+      worst_surface_g = std::max(worst_surface_g, std::abs(fast.g - slow.g) / slow.g);
+    }
     if (gradients == 40 || v % 21 != 0 || facing.size() < 2) continue;
     Mesh probe;
     probe.topology.add_vertex(to_openmesh(P));
@@ -129,19 +148,32 @@ void expect_reference_accuracy_on_photographs(const std::string& set) {
     fields.resize(1, views.size());
     fields.visible_count[0] = static_cast<std::uint16_t>(facing.size());
     std::copy(facing.begin(), facing.end(), fields.visible_views.begin());
+    fields.normal[0] = N;
     stage.run(probe.topology, {0, 1}, views, dx, fields);
-    if (!(fields.defined[0] & kGradientDefined)) continue;
-    const Eigen::Vector3d expected = test::slow_photo_gradient(stage, P, dx, cameras, images, facing);
-    ++gradients;
-    const double error = (fields.photo_gradient[0] - expected).norm() / expected.norm();
-    EXPECT_LT(error, 1e-4) << set << " vertex " << v;
-    worst_gradient = std::max(worst_gradient, error);
+    if (fields.defined[0] & kGradientDefined) {
+      const Eigen::Vector3d expected = test::slow_photo_gradient(stage, P, dx, cameras, images, facing);
+      ++gradients;
+      const double error = (fields.photo_gradient[0] - expected).norm() / expected.norm();
+      EXPECT_LT(error, 1e-4) << set << " vertex " << v;
+      worst_gradient = std::max(worst_gradient, error);
+    }
+    surface_stage.run(probe.topology, {0, 1}, views, dx, fields);
+    if (fields.defined[0] & kGradientDefined) {
+      const Eigen::Vector3d expected = test::slow_surface_patch_gradient(surface_stage, P, dx, layout, cameras, images);
+      ++surface_gradients;
+      const double error = (fields.photo_gradient[0] - expected).norm() / expected.norm();
+      EXPECT_LT(error, 1e-4) << set << " vertex " << v << ", surface patch";
+      worst_surface_gradient = std::max(worst_surface_gradient, error);
+    }
   }
   EXPECT_GT(compared, 300);
   EXPECT_EQ(gradients, 40);
+  EXPECT_GT(surface_compared, 300);
+  EXPECT_GT(surface_gradients, 30);
   std::printf("[measured] %s: g against the slow reference, largest relative difference %.2g (%d points, smallest g "
-              "%.2g); ∇g %.2g (%d vertices)\n",
-              set.c_str(), worst_g, compared, smallest_g, worst_gradient, gradients);
+              "%.2g); ∇g %.2g (%d vertices); surface patches: g %.2g (%d points), ∇g %.2g (%d vertices)\n",
+              set.c_str(), worst_g, compared, smallest_g, worst_gradient, gradients, worst_surface_g, surface_compared,
+              worst_surface_gradient, surface_gradients);
 }
 
 TEST(PhotoConsistency, EqualsSlowReferenceOnTheDinoPhotographs) {

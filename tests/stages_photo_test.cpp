@@ -32,6 +32,7 @@ namespace {
 
 using test::pointers;
 using test::slow_photo_consistency;
+using test::slow_surface_patch_consistency;
 
 // A smooth colour texture on the plane z = 0 (period ≈ 9–20 world units = pixels here).
 Eigen::Vector3f plane_texture(double x, double y) {
@@ -92,6 +93,13 @@ RandomRig random_rig(int count, double step, double height, std::mt19937& random
   return rig;
 }
 
+// A random unit normal: a surface patch's tangent plane at any tilt.
+Eigen::Vector3d random_normal(std::mt19937& random) {
+  std::normal_distribution<double> gaussian;
+  Eigen::Vector3d N(gaussian(random), gaussian(random), gaussian(random));
+  return N.normalized();
+}
+
 // photo_consistency against the slow reference at \p trials random points of the cube ±\p extent
 // with the (2·half_patch + 1)² patch, all views of \p rig: the same usable views and g within 1e-6
 // relative. Returns the largest relative difference; \p compared counts the points with defined g.
@@ -149,8 +157,20 @@ TEST(PhotoConsistency, EveryInstructionSetBuildGivesTheSameBits) {
   std::uniform_real_distribution<double> coordinate(-0.8, 0.8);
   int defined = 0;
   std::vector<PhotoValue> reference_samples(61), samples(61);
+  SurfacePatchLayout layout;
+  int surface_defined = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const Eigen::Vector3d X(coordinate(random), coordinate(random), coordinate(random));
+    // The surface patch kernel too, laid out at X and read at a gradient sample beside it.
+    layout_surface_patch(X, random_normal(random), all, views, 2, 1.5, layout);
+    const Eigen::Vector3d beside = X + Eigen::Vector3d(-0.004, 0.002, 0.003);
+    const PhotoValue surface = builds.front().surface(beside, layout, views);
+    surface_defined += surface.defined();
+    for (const auto& build : builds | std::views::drop(1)) {
+      const PhotoValue other = build.surface(beside, layout, views);
+      EXPECT_EQ(other.views, surface.views) << build.name;
+      EXPECT_EQ(other.g, surface.g) << build.name;  // exact
+    }
     const PhotoValue reference = builds.front().consistency(X, all, views);
     defined += reference.defined();
     builds.front().samples(X, 0.01, 10, all, views, reference_samples);
@@ -169,6 +189,7 @@ TEST(PhotoConsistency, EveryInstructionSetBuildGivesTheSameBits) {
     }
   }
   EXPECT_GT(defined, 200);
+  EXPECT_GT(surface_defined, 150);
   if (builds.size() < 2) GTEST_SKIP() << "only the baseline build runs on this CPU: nothing to compare it with";
 }
 
@@ -184,11 +205,16 @@ TEST(PhotoConsistency, EveryBuildGivesTheSameBitsBeyondItsStackBuffers) {
   std::uniform_real_distribution<double> coordinate(-0.5, 0.5);
   constexpr int half = 17;
   std::vector<PhotoValue> reference(6 * half + 1), samples(6 * half + 1);
-  int defined = 0;
+  SurfacePatchLayout layout;
+  int defined = 0, surface_defined = 0;
   for (int trial = 0; trial < 20; ++trial) {
     const Eigen::Vector3d X(coordinate(random), coordinate(random), coordinate(random));
     builds.front().samples(X, 0.004, half, all, views, reference);
     defined += reference[0].defined();
+    layout_surface_patch(X, random_normal(random), all, views, 2, 1.5, layout);  // 70 views: heap buffers
+    const PhotoValue surface = builds.front().surface(X, layout, views);
+    surface_defined += surface.defined();
+    for (const auto& build : builds | std::views::drop(1)) EXPECT_EQ(build.surface(X, layout, views).g, surface.g) << build.name;
     EXPECT_EQ(reference[0].g, builds.front().consistency(X, all, views).g);
     for (const auto& build : builds | std::views::drop(1)) {
       build.samples(X, 0.004, half, all, views, samples);
@@ -199,6 +225,7 @@ TEST(PhotoConsistency, EveryBuildGivesTheSameBitsBeyondItsStackBuffers) {
     }
   }
   EXPECT_GT(defined, 15);
+  EXPECT_GT(surface_defined, 10);
   if (builds.size() < 2) GTEST_SKIP() << "only the baseline build runs on this CPU: nothing to compare it with";
 }
 
@@ -769,6 +796,79 @@ TEST(SurfacePatch, EqualsTheExactProjectionOfItsTangentPoints) {
     }
   EXPECT_GT(compared, 100);
   EXPECT_GT(partial, 10);  // the border case: some views' patches leave their image
+}
+
+TEST(SurfacePatch, EqualsTheDoubleReferenceOnRandomImages) {
+  // SPEC §3's bound for the surface patch's float interpolation and float sums on shifted data:
+  // against the same laid-out points read and summed in double, on random images (the worst
+  // case: every pixel differs from its neighbours), patches 3×3, 5×5 and 7×7.
+  std::mt19937 random(29);
+  const RandomRig rig = random_rig(6, 0.35, 0.4, random);
+  const auto views = make_photo_views(rig.cameras, pointers(rig.images));
+  const std::vector<std::uint16_t> all{0, 1, 2, 3, 4, 5};
+  std::uniform_real_distribution<double> coordinate(-0.7, 0.7);
+  SurfacePatchLayout layout;
+  double worst = 0;
+  int compared = 0;
+  for (int h : {1, 2, 3})
+    for (int trial = 0; trial < 150; ++trial) {
+      const Eigen::Vector3d X(coordinate(random), coordinate(random), coordinate(random));
+      layout_surface_patch(X, random_normal(random), all, views, h, 1.5, layout);
+      const Eigen::Vector3d sample = X + Eigen::Vector3d(0.003, -0.002, 0.001);  // as a gradient sample
+      const PhotoValue fast = surface_patch_consistency(sample, layout, views);
+      const PhotoValue slow = slow_surface_patch_consistency(sample, layout, rig.cameras, rig.images);
+      ASSERT_EQ(fast.views, slow.views) << "h " << h << " at " << X.transpose();
+      if (!slow.defined()) continue;
+      ++compared;
+      EXPECT_NEAR(fast.g, slow.g, 1e-6 + 1e-5 * slow.g) << "h " << h;
+      worst = std::max(worst, std::abs(fast.g - slow.g) / slow.g);
+    }
+  EXPECT_GT(compared, 250);
+  std::printf("[measured] surface patches on random images: largest relative difference from the double "
+              "reference %.2g (%d points)\n", worst, compared);
+}
+
+TEST(SurfacePatch, ReadsTheImagesLastPixelWithoutPassingIt) {
+  // A patch whose bottom right point's support holds the image's last pixel (W − 1, H − 1): the
+  // kernel reads that pixel's right neighbour from earlier floats (nothing lies after it; the
+  // sanitizer run holds this test too). Two views, hand-made offsets of 0.6 px.
+  std::mt19937 random(31);
+  const RandomRig rig = random_rig(2, 0.0, 0.0, random);  // one camera, two images
+  const auto views = make_photo_views(rig.cameras, pointers(rig.images));
+  const Camera& first = rig.cameras[0];
+  int at_last_pixel = 0;
+  for (const double fraction : {0.05, 0.5, 0.95}) {
+    // X on the first view's ray through the pixel whose patch's bottom right point falls in the
+    // last pixel's 2×2 support (x0 = W − 2, y0 = H − 2).
+    const double u = first.width() - 2 - 0.6 + fraction, v = first.height() - 2 - 0.6 + fraction;
+    const Ray ray = first.ray(u, v);
+    const Eigen::Vector3d X = ray.origin + 3.0 * ray.direction;
+    SurfacePatchLayout layout;
+    layout.half_patch = 1;
+    layout.points = 9;
+    layout.padded_points = kSurfacePatchLanes;
+    layout.views = {0, 1};
+    for (int k = 0; k < 2; ++k) {
+      for (int b = -1; b <= 1; ++b)
+        for (int a = -1; a <= 1; ++a) {
+          layout.du.push_back(0.6f * a);
+          layout.dv.push_back(0.6f * b);
+        }
+      layout.du.resize((k + 1) * kSurfacePatchLanes, 0.0f);
+      layout.dv.resize((k + 1) * kSurfacePatchLanes, 0.0f);
+      layout.bounds.insert(layout.bounds.end(), {-0.6f, 0.6f, -0.6f, 0.6f});
+    }
+    const Projection p = first.project(X);
+    at_last_pixel += std::floor(p.u + 0.6f) == first.width() - 2 && std::floor(p.v + 0.6f) == first.height() - 2;
+    const PhotoValue slow = slow_surface_patch_consistency(X, layout, rig.cameras, rig.images);
+    for (const auto& build : detail::photo_kernel_builds()) {
+      const PhotoValue fast = build.surface(X, layout, views);
+      ASSERT_EQ(fast.views, slow.views) << build.name;
+      EXPECT_NEAR(fast.g, slow.g, 1e-6 + 1e-5 * slow.g) << build.name;
+    }
+    EXPECT_EQ(slow.views, 2);
+  }
+  EXPECT_EQ(at_last_pixel, 3);
 }
 
 TEST(SurfacePatch, TheGradientStagePointsAwayFromThePlane) {

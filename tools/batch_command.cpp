@@ -210,7 +210,9 @@ void add_batch_command(CLI::App& app, Runner& runner) {
           },
           "i/n"))
       ->capture_default_str();
-  c->add_option("--preset", args->preset, "default or thesis")->check(CLI::IsMember({"default", "thesis"}))->capture_default_str();
+  c->add_option("--preset", args->preset, "default, accurate or thesis (as refine's)")
+      ->check(CLI::IsMember({"default", "accurate", "thesis"}))
+      ->capture_default_str();
   c->add_option("--threads", args->threads, "Threads per refinement (0 = all cores)")->capture_default_str();
   c->add_option("--masks", args->masks,
                 "Each scene's mask folder, relative to the scene folder (e.g. masks): as refine --masks");

@@ -102,8 +102,10 @@ void add_refine_command(CLI::App& app, Runner& runner) {
                 "Folder of silhouette masks, one per view named after its photograph (object: any channel > 0): the "
                 "rims are fitted to them (with --fit-silhouettes auto or on) and anchor the unobserved spread, and "
                 "--keep-inside-silhouettes uses them, instead of thresholded photographs");
-  c->add_option("--preset", args->preset, "Parameter set: default or thesis (exactly the thesis's B.7 values)")
-      ->check(CLI::IsMember({"default", "thesis"}))
+  c->add_option("--preset", args->preset,
+                "Parameter set: default, accurate (surface patches, --settle-tolerance 0.001: lower error, "
+                "1.6-2.3x the time) or thesis (exactly the thesis's B.7 values)")
+      ->check(CLI::IsMember({"default", "accurate", "thesis"}))
       ->capture_default_str();
   c->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber)->capture_default_str();
   add_refine_options(*c);  // every RefineOptions field, from tools/refine_option_table

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "engine/model/error.h"
+#include "stages/flow/surface_patch.h"
 
 // The 8-lane vector types are passed only between always-inlined functions of one build.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -22,6 +23,7 @@ namespace mvflow::detail {
 namespace baseline {
 constexpr int kLanes = 2;  // two doubles per register: SSE2 on x86-64, the portable vectors elsewhere (arm64)
 #include "stages/flow/photo_kernel_body.inc"
+#include "stages/flow/surface_patch_kernel_body.inc"
 }  // namespace baseline
 
 #ifdef MVFLOW_KERNEL_X86
@@ -31,6 +33,7 @@ constexpr int kLanes = 2;  // two doubles per register: SSE2 on x86-64, the port
 namespace avx2 {
 constexpr int kLanes = 4;  // four doubles per ymm register
 #include "stages/flow/photo_kernel_body.inc"
+#include "stages/flow/surface_patch_kernel_body.inc"
 }  // namespace avx2
 #undef MVFLOW_KERNEL_AVX2
 #pragma GCC pop_options
@@ -45,6 +48,7 @@ constexpr int kLanes = 4;  // four doubles per ymm register
 namespace avx512 {
 constexpr int kLanes = 8;  // eight doubles per zmm register
 #include "stages/flow/photo_kernel_body.inc"
+#include "stages/flow/surface_patch_kernel_body.inc"
 }  // namespace avx512
 #undef MVFLOW_KERNEL_AVX512
 #pragma GCC diagnostic pop
@@ -112,12 +116,15 @@ void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> v
 
 std::vector<PhotoKernelBuild> photo_kernel_builds() {
   std::vector<PhotoKernelBuild> builds{
-      {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_samples}};
+      {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_samples,
+       &baseline::surface_patch_consistency}};
 #ifdef MVFLOW_KERNEL_X86
   if (__builtin_cpu_supports("x86-64-v3"))
-    builds.push_back({"avx2", &avx2::photo_consistency_5x5, &avx2::photo_consistency_5x5_samples});
+    builds.push_back({"avx2", &avx2::photo_consistency_5x5, &avx2::photo_consistency_5x5_samples,
+                      &avx2::surface_patch_consistency});
   if (__builtin_cpu_supports("x86-64-v4"))
-    builds.push_back({"avx512", &avx512::photo_consistency_5x5, &avx512::photo_consistency_5x5_samples});
+    builds.push_back({"avx512", &avx512::photo_consistency_5x5, &avx512::photo_consistency_5x5_samples,
+                      &avx512::surface_patch_consistency});
 #endif
   return builds;
 }

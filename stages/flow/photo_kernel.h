@@ -1,12 +1,13 @@
 #pragma once
-// The hot loops of the photo stages for the default 5×5 patch (SPEC §3), in three builds of the
+// The hot loops of the photo stages, for the default 5×5 patch (SPEC §3) and for surface patches
+// (stages/flow/surface_patch.h, surface_patch_kernel_body.inc), in three builds of the
 // same source (x86-64 baseline, AVX2, AVX-512; the baseline alone on other processors), one of
 // them chosen once, on first use, by active_photo_kernel(): the one named by the environment
 // variable MVFLOW_KERNEL (baseline, avx2 or avx512), else the widest one the CPU runs. Every build gives the same bits: each patch value is
 // interpolated, shifted by the first view's value and summed over the views by the same float
 // operations in the same order (no FMA contraction; SPEC §3's float sums on shifted data), and
-// the values' totals are summed in one fixed order; only the lane width differs. Callers use photo_consistency()
-// and PhotoGradientStage.
+// the values' totals are summed in one fixed order; only the lane width differs. Callers use photo_consistency(),
+// surface_patch_consistency() and PhotoGradientStage.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -16,6 +17,10 @@
 
 #include "stages/flow/photo_consistency.h"
 #include "stages/flow/photo_views.h"
+
+namespace mvflow {
+struct SurfacePatchLayout;
+}
 
 namespace mvflow::detail {
 
@@ -45,6 +50,8 @@ struct PhotoKernelBuild {
   PhotoValue (*consistency)(const Eigen::Vector3d&, std::span<const std::uint16_t>, const std::vector<PhotoView>&);
   void (*samples)(const Eigen::Vector3d&, double, int, std::span<const std::uint16_t>, const std::vector<PhotoView>&,
                   std::span<PhotoValue>);
+  //! surface_patch_consistency() (stages/flow/surface_patch.h)
+  PhotoValue (*surface)(const Eigen::Vector3d&, const SurfacePatchLayout&, const std::vector<PhotoView>&);
 };
 //! The builds this CPU can run, baseline first.
 std::vector<PhotoKernelBuild> photo_kernel_builds();

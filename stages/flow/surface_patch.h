@@ -18,14 +18,20 @@
 
 namespace mvflow {
 
+//! The points of a laid-out patch are padded to a multiple of this (the floats of the widest
+//! register of the photo kernel's builds), so that every build reads them in whole registers.
+inline constexpr int kSurfacePatchLanes = 16;
+
 //! Where the surface patch of one vertex falls in each of its views: per view the pixel offsets of
 //! the (2h+1)² tangent-plane points from the projection of the vertex, rows of the tangent grid
 //! in order. Laid out once per vertex; the gradient's samples (within e_min/2 of the vertex) reuse
 //! it, shifted with their own projection.
 struct SurfacePatchLayout {
   int half_patch = 2;
+  int points = 25;                   //!< (2h+1)²
+  int padded_points = 32;            //!< points rounded up to kSurfacePatchLanes
   std::vector<std::uint16_t> views;  //!< the views laid out (those with the vertex in front)
-  std::vector<float> offsets;        //!< per laid-out view, (2h+1)² pairs (du, dv)
+  std::vector<float> du, dv;         //!< per laid-out view, padded_points offsets in pixels (padding: 0)
   std::vector<float> bounds;         //!< per laid-out view: the offsets' smallest du, largest du, smallest dv, largest dv
 };
 
@@ -43,7 +49,8 @@ void layout_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, st
 
 //! g at \p X (near the laid-out point) with the laid-out patch: the same variance as
 //! photo_consistency() over the patch's bilinear samples; a view whose patch leaves the image
-//! (with its bilinear support) does not count.
+//! (with its bilinear support) does not count. Runs the photo kernel's build
+//! (detail::active_photo_kernel()); the float sums on shifted data of SPEC §3.
 PhotoValue surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
                                      const std::vector<PhotoView>& views);
 
