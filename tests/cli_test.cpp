@@ -33,6 +33,16 @@ TEST(Cli, BadUsageExitsTwo) {
   EXPECT_EQ(run("--log-level loud info x").exit_code, 2);
 }
 
+TEST(Cli, SliceRefusesAnOptionOutOfRangeUnderItsFlag) {
+  // The range is the photo options' check()'s (as refine's), refused before the scene is read.
+  const CommandResult spacing = run("slice " + kDefaultScene.string() + " -o unused.png --surface-patch on --surface-patch-spacing 20");
+  EXPECT_EQ(spacing.exit_code, 2) << spacing.output;
+  EXPECT_NE(spacing.output.find("--surface-patch-spacing: option surface_patch_spacing = 20 is out of range: expected (0, 8]"),
+            std::string::npos)
+      << spacing.output;
+  EXPECT_FALSE(fs::exists("unused.png"));
+}
+
 TEST(Cli, InfoDescribesTheDefaultScene) {
   test::ScratchFolder folder;
   const CommandResult r = run("info " + kDefaultScene.string() + " --json " + (folder / "info.json").string());

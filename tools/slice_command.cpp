@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "engine/model/error.h"
+#include "engine/model/option_check.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/scene_io.h"
@@ -121,7 +122,20 @@ void add_slice_command(CLI::App& app, Runner& runner) {
                       "Surface patch: spacing of its points in pixels of the finest view (valid: (0, 8])")
       ->capture_default_str();
   command->add_flag("--linear", args->linear, "Linear colour scale instead of log10");
-  command->callback([args, &runner] { runner = [args](spdlog::logger& log) { return run_slice(*args, log); }; });
+  command->callback([args, &runner] {
+    // The photo options' ranges are their check()'s; a value out of range is refused now, under
+    // its flag (exit 2), as refine does.
+    PhotoConsistencyOptions photo = args->options.photo;
+    photo.surface_patch = args->surface_patch == "on";
+    try {
+      photo.check();
+    } catch (const OptionError& e) {
+      if (e.option() == "half_patch") throw CLI::ValidationError("--patch", e.what());
+      if (e.option() == "surface_patch_spacing") throw CLI::ValidationError("--surface-patch-spacing", e.what());
+      throw CLI::ValidationError(e.what());
+    }
+    runner = [args](spdlog::logger& log) { return run_slice(*args, log); };
+  });
 }
 
 }  // namespace mvflow::cli
