@@ -1,11 +1,11 @@
 #include "stages/flow/surface_patch.h"
 
-#include "engine/model/error.h"
-#include "stages/flow/photo_kernel.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "engine/model/error.h"
+#include "stages/flow/photo_kernel.h"
 
 namespace mvflow {
 
