@@ -1,5 +1,5 @@
-// The photo kernel on its own, against a plain double-precision evaluation of SPEC §3, for every
-// build of the kernel this CPU runs. Standalone (no GoogleTest, no oneTBB, OpenCV or Embree) so
+// The photo kernel on its own (the 5×5 pixel patch and surface patches), against a plain
+// double-precision evaluation of SPEC §3, for every build of the kernel this CPU runs. Standalone (no GoogleTest, no oneTBB, OpenCV or Embree) so
 // that tools/check_portable.sh can cross-compile it for arm64 from four engine sources and run
 // it under qemu; the test suite runs the same program natively. Exits 1 on a mismatch.
 
@@ -19,6 +19,7 @@
 #include "stages/flow/photo_consistency.h"
 #include "stages/flow/photo_kernel.h"
 #include "stages/flow/photo_views.h"
+#include "stages/flow/surface_patch.h"
 
 namespace mvflow {
 namespace {
@@ -91,34 +92,31 @@ Scene plane_scene() {
 
 // The reference: projection from K, R, t (and the radial model d = n·(1 + k1 r² + k2 r⁴)),
 // every patch value bilinear on its own in double, the variances by the two-pass formula.
-PhotoValue reference_g(const Scene& scene, const Eigen::Vector3d& X) {
-  std::vector<std::vector<double>> patches;
-  for (std::size_t i = 0; i < scene.cameras.size(); ++i) {
-    const Camera& camera = scene.cameras[i];
-    const Eigen::Vector3d c = camera.R() * X + camera.t();
-    if (!(c.z() > 0)) continue;
-    Eigen::Vector2d n(c.x() / c.z(), c.y() / c.z());
-    if (camera.distortion().model == DistortionModel::Radial) {
-      const auto& k = camera.distortion().coefficients;
-      const double r2 = n.squaredNorm();
-      n *= 1 + k[0] * r2 + k[1] * r2 * r2;
-    }
-    const double u = camera.K()(0, 0) * n.x() + camera.K()(0, 1) * n.y() + camera.K()(0, 2);
-    const double v = camera.K()(1, 1) * n.y() + camera.K()(1, 2);
-    const int W = camera.width(), H = camera.height();
-    if (u < 2 || v < 2 || u >= W - 3 || v >= H - 3) continue;
-    const Image& image = scene.images[i];
-    std::vector<double> patch;
-    for (int dy = -2; dy <= 2; ++dy)
-      for (int dx = -2; dx <= 2; ++dx) {
-        const int x0 = static_cast<int>(std::floor(u + dx)), y0 = static_cast<int>(std::floor(v + dy));
-        const double a = u + dx - x0, b = v + dy - y0;
-        for (int ch = 0; ch < 3; ++ch)
-          patch.push_back((1 - a) * (1 - b) * image.pixel(x0, y0)[ch] + a * (1 - b) * image.pixel(x0 + 1, y0)[ch] +
-                          (1 - a) * b * image.pixel(x0, y0 + 1)[ch] + a * b * image.pixel(x0 + 1, y0 + 1)[ch]);
-      }
-    patches.push_back(std::move(patch));
+// The pixel (u, v) of X in \p camera; false when X is not in front of it.
+bool reference_projection(const Camera& camera, const Eigen::Vector3d& X, double& u, double& v) {
+  const Eigen::Vector3d c = camera.R() * X + camera.t();
+  if (!(c.z() > 0)) return false;
+  Eigen::Vector2d n(c.x() / c.z(), c.y() / c.z());
+  if (camera.distortion().model == DistortionModel::Radial) {
+    const auto& k = camera.distortion().coefficients;
+    const double r2 = n.squaredNorm();
+    n *= 1 + k[0] * r2 + k[1] * r2 * r2;
   }
+  u = camera.K()(0, 0) * n.x() + camera.K()(0, 1) * n.y() + camera.K()(0, 2);
+  v = camera.K()(1, 1) * n.y() + camera.K()(1, 2);
+  return true;
+}
+
+// The bilinear value of channel ch at (u, v) in double.
+double reference_bilinear(const Image& image, double u, double v, int ch) {
+  const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
+  const double a = u - x0, b = v - y0;
+  return (1 - a) * (1 - b) * image.pixel(x0, y0)[ch] + a * (1 - b) * image.pixel(x0 + 1, y0)[ch] +
+         (1 - a) * b * image.pixel(x0, y0 + 1)[ch] + a * b * image.pixel(x0 + 1, y0 + 1)[ch];
+}
+
+// SPEC §3's variance over the patches of the usable views (the two-pass formula), per point.
+PhotoValue reference_variance(const std::vector<std::vector<double>>& patches, int points) {
   PhotoValue result;
   result.views = static_cast<int>(patches.size());
   if (patches.size() < 2) return result;
@@ -127,9 +125,80 @@ PhotoValue reference_g(const Scene& scene, const Eigen::Vector3d& X) {
     double mean = 0, variance = 0;
     for (const auto& p : patches) mean += p[k] / m;
     for (const auto& p : patches) variance += (p[k] - mean) * (p[k] - mean) / (m - 1);
-    result.g += variance / 25;
+    result.g += variance / points;
   }
   return result;
+}
+
+PhotoValue reference_g(const Scene& scene, const Eigen::Vector3d& X) {
+  std::vector<std::vector<double>> patches;
+  for (std::size_t i = 0; i < scene.cameras.size(); ++i) {
+    const Camera& camera = scene.cameras[i];
+    double u, v;
+    if (!reference_projection(camera, X, u, v)) continue;
+    const int W = camera.width(), H = camera.height();
+    if (u < 2 || v < 2 || u >= W - 3 || v >= H - 3) continue;
+    const Image& image = scene.images[i];
+    std::vector<double> patch;
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dx = -2; dx <= 2; ++dx)
+        for (int ch = 0; ch < 3; ++ch) patch.push_back(reference_bilinear(image, u + dx, v + dy, ch));
+    patches.push_back(std::move(patch));
+  }
+  return reference_variance(patches, 25);
+}
+
+// A surface patch laid out by hand (stages/flow/surface_patch.h's layout, without the engine
+// sources that lay it out): per view in front of X a 5×5 grid of offsets 1.3 pixels apart,
+// turned and squeezed by the view's own angle and factor, as an oblique view's would be.
+SurfacePatchLayout hand_layout(const Scene& scene, const Eigen::Vector3d& X) {
+  SurfacePatchLayout layout;
+  layout.half_patch = 2;
+  layout.points = 25;
+  layout.padded_points = kSurfacePatchLanes * 2;
+  for (std::size_t i = 0; i < scene.cameras.size(); ++i) {
+    double u, v;
+    if (!reference_projection(scene.cameras[i], X, u, v)) continue;
+    layout.views.push_back(static_cast<std::uint16_t>(i));
+    const double angle = 0.4 * static_cast<double>(i), squeeze = 1.0 - 0.12 * static_cast<double>(i);
+    float bounds[4] = {1e30f, -1e30f, 1e30f, -1e30f};
+    for (int b = -2; b <= 2; ++b)
+      for (int a = -2; a <= 2; ++a) {
+        const double x = 1.3 * a, y = 1.3 * squeeze * b;
+        const auto du = static_cast<float>(std::cos(angle) * x - std::sin(angle) * y);
+        const auto dv = static_cast<float>(std::sin(angle) * x + std::cos(angle) * y);
+        layout.du.push_back(du);
+        layout.dv.push_back(dv);
+        bounds[0] = std::min(bounds[0], du), bounds[1] = std::max(bounds[1], du);
+        bounds[2] = std::min(bounds[2], dv), bounds[3] = std::max(bounds[3], dv);
+      }
+    layout.du.resize(layout.views.size() * layout.padded_points, 0.0f);
+    layout.dv.resize(layout.views.size() * layout.padded_points, 0.0f);
+    layout.bounds.insert(layout.bounds.end(), bounds, bounds + 4);
+  }
+  return layout;
+}
+
+// The surface patch's reference: per laid-out view, X's projection plus each offset, read in
+// double; a view counts when every point's 2×2 support lies in its image.
+PhotoValue reference_surface_g(const Scene& scene, const Eigen::Vector3d& X, const SurfacePatchLayout& layout) {
+  std::vector<std::vector<double>> patches;
+  for (std::size_t k = 0; k < layout.views.size(); ++k) {
+    const Camera& camera = scene.cameras[layout.views[k]];
+    double u, v;
+    if (!reference_projection(camera, X, u, v)) continue;
+    std::vector<double> patch;
+    bool inside = true;
+    for (int i = 0; i < layout.points && inside; ++i) {
+      const std::size_t e = k * static_cast<std::size_t>(layout.padded_points) + static_cast<std::size_t>(i);
+      const double pu = u + layout.du[e], pv = v + layout.dv[e];
+      inside = std::floor(pu) >= 0 && std::floor(pv) >= 0 && std::floor(pu) + 1 <= camera.width() - 1 &&
+               std::floor(pv) + 1 <= camera.height() - 1;
+      for (int ch = 0; ch < 3 && inside; ++ch) patch.push_back(reference_bilinear(scene.images[layout.views[k]], pu, pv, ch));
+    }
+    if (inside) patches.push_back(std::move(patch));
+  }
+  return reference_variance(patches, layout.points);
 }
 
 // As make_photo_views(cameras, images) builds them: photo_views.cpp also holds the scene
@@ -205,6 +274,9 @@ Tally check_build(const Scene& scene, const detail::PhotoKernelBuild& build, int
     const Eigen::Vector3d X = draw_point(random, scene);
     const PhotoValue g = build.consistency(X, ids, views);
     compare(g, reference_g(scene, X), "g at point " + std::to_string(p), tally);
+    const SurfacePatchLayout layout = hand_layout(scene, X);
+    compare(build.surface(X, layout, views), reference_surface_g(scene, X, layout),
+            "surface patch g at point " + std::to_string(p), tally);
     if (p >= sampled) continue;
     build.samples(X, spacing, half, ids, views, samples);
     ++tally.compared;
@@ -235,7 +307,11 @@ int compare_builds(const Scene& scene, const std::vector<detail::PhotoKernelBuil
   for (int p = 0; p < 50; ++p) {
     const Eigen::Vector3d X = draw_point(random, scene);
     builds[0].samples(X, 0.004, 10, ids, views, first);
+    const SurfacePatchLayout layout = hand_layout(scene, X);
+    const PhotoValue surface = builds[0].surface(X, layout, views);
     for (std::size_t b = 1; b < builds.size(); ++b) {
+      const PhotoValue other_surface = builds[b].surface(X, layout, views);
+      differing += other_surface.g != surface.g || other_surface.views != surface.views;
       builds[b].samples(X, 0.004, 10, ids, views, other);
       const std::size_t written = first[0].defined() ? 61 : 1;
       for (std::size_t s = 0; s < written; ++s)
