@@ -2,6 +2,7 @@
 // The double-precision reference of SPEC §3's photo consistency, for the tests that hold the
 // photo kernel (float interpolation, float sums on shifted data) to its bounds.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -87,8 +88,8 @@ inline Eigen::Vector3d slow_photo_gradient(const PhotoGradientStage& stage, cons
 
 // The slow reference of the surface patch at X with the laid-out patch: per laid-out view, X
 // projected by its camera, each point at that projection plus its layout offset, read bilinearly
-// in double; a view counts when every point's 2×2 support lies in the image; variances by the
-// two-pass formula.
+// in double; a view counts when every point's 2×2 support lies in the image (positions rounded as
+// the kernel's); variances by the two-pass formula.
 inline PhotoValue slow_surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
                                                  const std::vector<Camera>& cameras, const std::vector<Image>& images) {
   std::vector<std::vector<double>> patches;
@@ -102,9 +103,13 @@ inline PhotoValue slow_surface_patch_consistency(const Eigen::Vector3d& X, const
     for (int i = 0; i < layout.points && inside; ++i) {
       const std::size_t e = k * static_cast<std::size_t>(layout.padded_points) + static_cast<std::size_t>(i);
       const double u = centre.u + layout.du[e], v = centre.v + layout.dv[e];
-      const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
-      inside = x0 >= 0 && y0 >= 0 && x0 + 1 <= W - 1 && y0 + 1 <= H - 1;
+      // Inside as the kernel decides it, from its float positions (surface_patch.h): at an image's
+      // border the double position may fall a rounding the other side.
+      const double x_inside = std::floor(centre.u) + std::floor(static_cast<float>(centre.u - std::floor(centre.u)) + layout.du[e]);
+      const double y_inside = std::floor(centre.v) + std::floor(static_cast<float>(centre.v - std::floor(centre.v)) + layout.dv[e]);
+      inside = x_inside >= 0 && y_inside >= 0 && x_inside + 1 <= W - 1 && y_inside + 1 <= H - 1;
       if (!inside) break;
+      const int x0 = std::clamp(static_cast<int>(std::floor(u)), 0, W - 2), y0 = std::clamp(static_cast<int>(std::floor(v)), 0, H - 2);
       const double a = u - x0, b = v - y0;
       for (int c = 0; c < 3; ++c)
         patch.push_back((1 - a) * (1 - b) * images[id].pixel(x0, y0)[c] + a * (1 - b) * images[id].pixel(x0 + 1, y0)[c] +

@@ -217,7 +217,7 @@ void add_batch_command(CLI::App& app, Runner& runner) {
   c->add_option("--masks", args->masks,
                 "Each scene's mask folder, relative to the scene folder (e.g. masks): as refine --masks");
   // The stopping rules compare the last `lookback` iterations with one before them, so no budget
-  // below lookback + 1 can be met (lookback is 5 in both presets).
+  // below lookback + 1 can be met (lookback is 5 in every preset).
   const int smallest = StoppingOptions{}.lookback + 1;
   c->add_option("--max-iterations", args->max_iterations,
                 "Override the preset's iteration limit (0 = keep, else >= " + std::to_string(smallest) + ")")

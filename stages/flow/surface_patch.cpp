@@ -66,6 +66,10 @@ void layout_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, st
       layout.dv.resize(first);
       continue;
     }
+    // The padding repeats the last point: the kernel reads the padded points too (and does not
+    // sum them), so they must lie inside the box the bounds test checks.
+    std::fill(layout.du.begin() + static_cast<std::ptrdiff_t>(i), layout.du.end(), layout.du[i - 1]);
+    std::fill(layout.dv.begin() + static_cast<std::ptrdiff_t>(i), layout.dv.end(), layout.dv[i - 1]);
     layout.views.push_back(id);
     layout.bounds.insert(layout.bounds.end(), bounds, bounds + 4);
   }

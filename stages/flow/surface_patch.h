@@ -31,7 +31,7 @@ struct SurfacePatchLayout {
   int points = 25;                   //!< (2h+1)²
   int padded_points = 32;            //!< points rounded up to kSurfacePatchLanes
   std::vector<std::uint16_t> views;  //!< the views laid out (those with the vertex in front)
-  std::vector<float> du, dv;         //!< per laid-out view, padded_points offsets in pixels (padding: 0)
+  std::vector<float> du, dv;         //!< per laid-out view, padded_points offsets in pixels (padding: the last point's)
   std::vector<float> bounds;         //!< per laid-out view: the offsets' smallest du, largest du, smallest dv, largest dv
 };
 
@@ -49,7 +49,8 @@ void layout_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, st
 
 //! g at \p X (near the laid-out point) with the laid-out patch: the same variance as
 //! photo_consistency() over the patch's bilinear samples; a view whose patch leaves the image
-//! (with its bilinear support) does not count. Runs the photo kernel's build
+//! (with its bilinear support) does not count, the points' positions taken in float relative to
+//! the projection's pixel, (u − ⌊u⌋) + du (within about 1e-6 pixel of u + du). Runs the photo kernel's build
 //! (detail::active_photo_kernel()); the float sums on shifted data of SPEC §3.
 PhotoValue surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
                                      const std::vector<PhotoView>& views);

@@ -90,9 +90,8 @@ Scene plane_scene() {
   return scene;
 }
 
-// The reference: projection from K, R, t (and the radial model d = n·(1 + k1 r² + k2 r⁴)),
-// every patch value bilinear on its own in double, the variances by the two-pass formula.
-// The pixel (u, v) of X in \p camera; false when X is not in front of it.
+// The pixel (u, v) of X in \p camera from K, R, t (and the radial model d = n·(1 + k1 r² + k2 r⁴));
+// false when X is not in front of it.
 bool reference_projection(const Camera& camera, const Eigen::Vector3d& X, double& u, double& v) {
   const Eigen::Vector3d c = camera.R() * X + camera.t();
   if (!(c.z() > 0)) return false;
@@ -130,6 +129,8 @@ PhotoValue reference_variance(const std::vector<std::vector<double>>& patches, i
   return result;
 }
 
+// The reference: every patch value bilinear on its own in double, the variances by the two-pass
+// formula.
 PhotoValue reference_g(const Scene& scene, const Eigen::Vector3d& X) {
   std::vector<std::vector<double>> patches;
   for (std::size_t i = 0; i < scene.cameras.size(); ++i) {
@@ -172,8 +173,9 @@ SurfacePatchLayout hand_layout(const Scene& scene, const Eigen::Vector3d& X) {
         bounds[0] = std::min(bounds[0], du), bounds[1] = std::max(bounds[1], du);
         bounds[2] = std::min(bounds[2], dv), bounds[3] = std::max(bounds[3], dv);
       }
-    layout.du.resize(layout.views.size() * layout.padded_points, 0.0f);
-    layout.dv.resize(layout.views.size() * layout.padded_points, 0.0f);
+    const float last_du = layout.du.back(), last_dv = layout.dv.back();  // the padding repeats the last point
+    layout.du.resize(layout.views.size() * layout.padded_points, last_du);
+    layout.dv.resize(layout.views.size() * layout.padded_points, last_dv);
     layout.bounds.insert(layout.bounds.end(), bounds, bounds + 4);
   }
   return layout;
@@ -192,8 +194,10 @@ PhotoValue reference_surface_g(const Scene& scene, const Eigen::Vector3d& X, con
     for (int i = 0; i < layout.points && inside; ++i) {
       const std::size_t e = k * static_cast<std::size_t>(layout.padded_points) + static_cast<std::size_t>(i);
       const double pu = u + layout.du[e], pv = v + layout.dv[e];
-      inside = std::floor(pu) >= 0 && std::floor(pv) >= 0 && std::floor(pu) + 1 <= camera.width() - 1 &&
-               std::floor(pv) + 1 <= camera.height() - 1;
+      // Inside as the kernel decides it, from its float positions (surface_patch.h).
+      const double x0 = std::floor(u) + std::floor(static_cast<float>(u - std::floor(u)) + layout.du[e]);
+      const double y0 = std::floor(v) + std::floor(static_cast<float>(v - std::floor(v)) + layout.dv[e]);
+      inside = x0 >= 0 && y0 >= 0 && x0 + 1 <= camera.width() - 1 && y0 + 1 <= camera.height() - 1;
       for (int ch = 0; ch < 3 && inside; ++ch) patch.push_back(reference_bilinear(scene.images[layout.views[k]], pu, pv, ch));
     }
     if (inside) patches.push_back(std::move(patch));
