@@ -52,7 +52,6 @@ int run_slice(const SliceArguments& args, spdlog::logger& log) {
   PhotoSliceOptions options = args.options;
   options.axis = args.axis == "x" ? 0 : args.axis == "y" ? 1 : 2;
   options.views = args.views == "all" ? SliceViews::All : SliceViews::NearestVertex;
-  options.photo.surface_patch = args.surface_patch == "on";
   const PhotoSlice slice = compute_photo_slice(mesh.topology, make_photo_views(scene), options);
 
   // Colour scale: log10 g between the 2nd and 98th percentiles of the defined samples (g spans
@@ -125,10 +124,9 @@ void add_slice_command(CLI::App& app, Runner& runner) {
   command->callback([args, &runner] {
     // The photo options' ranges are their check()'s; a value out of range is refused now, under
     // its flag (exit 2), as refine does.
-    PhotoConsistencyOptions photo = args->options.photo;
-    photo.surface_patch = args->surface_patch == "on";
+    args->options.photo.surface_patch = args->surface_patch == "on";
     try {
-      photo.check();
+      args->options.photo.check();
     } catch (const OptionError& e) {
       if (e.option() == "half_patch") throw CLI::ValidationError("--patch", e.what());
       if (e.option() == "surface_patch_spacing") throw CLI::ValidationError("--surface-patch-spacing", e.what());

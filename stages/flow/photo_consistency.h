@@ -82,7 +82,7 @@ class PatchVariance {
 }  // namespace detail
 
 //! g(X) over the views \p view_ids of \p views, with whole-pixel image patches: the surface patch
-//! (options.surface_patch) needs the surface's normal, surface_patch_consistency() takes it.
+//! (options.surface_patch) needs the surface's normal, photo_consistency_at_surface() takes it.
 PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                              const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options = {});
 
