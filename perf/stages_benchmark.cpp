@@ -28,6 +28,7 @@
 #include "stages/flow/regularization.h"
 #include "stages/flow/smoothing.h"
 #include "stages/flow/speed.h"
+#include "stages/flow/surface_patch.h"
 #include "stages/flow/visibility.h"
 
 namespace mvflow {
@@ -181,6 +182,35 @@ void BM_PhotoGradientSurfacePatch(benchmark::State& state) {
   state.SetLabel("61 evaluations of g per vertex, surface patches");
 }
 BENCHMARK(BM_PhotoGradientSurfacePatch)->Unit(benchmark::kMillisecond);
+
+// What BM_PhotoGradientSurfacePatch computes (each layout and g the same bits), one
+// surface_patch_consistency per sample: the plain path the samples kernel replaces
+// (stages/flow/surface_patch_samples_body.inc), for the ratio in one run.
+void BM_PhotoGradientSurfacePatchPerSample(benchmark::State& state) {
+  const StageScene& s = scene();
+  const VertexFields fields = visible_fields();
+  PhotoConsistencyOptions photo;
+  photo.surface_patch = true;
+  const double spacing = sample_spacing();
+  const int half = PhotoGradientOptions{}.savitzky_golay.half_window();
+  SurfacePatchLayout layout;
+  for (auto _ : state) {
+    double total = 0;
+    for (std::uint32_t v = 0; v < s.n_vertices(); ++v) {
+      const Eigen::Vector3d X = to_eigen(s.mesh().point(TriMesh::VertexHandle(static_cast<int>(v))));
+      layout_surface_patch(X, fields.normal[v], fields.visible(v), s.views, photo.half_patch, photo.surface_patch_spacing,
+                           layout);
+      for_each_gradient_sample(X, spacing, half, [&](std::size_t, const Eigen::Vector3d& point) {
+        total += surface_patch_consistency(point, layout, s.views).g;
+        return true;
+      });
+    }
+    benchmark::DoNotOptimize(total);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(s.n_vertices()));
+  state.SetLabel("BM_PhotoGradientSurfacePatch's g values, one sample at a time");
+}
+BENCHMARK(BM_PhotoGradientSurfacePatchPerSample)->Unit(benchmark::kMillisecond);
 
 // The bound for BM_PhotoGradient's patch_pixel_reads/s: its reads without its arithmetic.
 void BM_PatchGatherBound(benchmark::State& state) {

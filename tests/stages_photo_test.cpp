@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -13,6 +14,7 @@
 #include <numeric>
 #include <random>
 #include <ranges>
+#include <string>
 
 #include "engine/model/primitives.h"
 #include "engine/model/surface_query.h"
@@ -803,14 +805,21 @@ TEST(SurfacePatch, EqualsTheExactProjectionOfItsTangentPoints) {
   EXPECT_GT(partial, 10);  // the border case: some views' patches leave their image
 }
 
+// Six views of random images on an arc around the origin, as the surface patch tests use them.
+struct SixViewRig {
+  explicit SixViewRig(std::mt19937& random)
+      : rig(random_rig(6, 0.35, 0.4, random)), views(make_photo_views(rig.cameras, pointers(rig.images))) {}
+  RandomRig rig;
+  std::vector<PhotoView> views;
+  std::vector<std::uint16_t> all{0, 1, 2, 3, 4, 5};
+};
+
 TEST(SurfacePatch, EqualsTheDoubleReferenceOnRandomImages) {
   // SPEC §3's bound for the surface patch's float interpolation and float sums on shifted data:
   // against the same laid-out points read and summed in double, on random images (the worst
   // case: every pixel differs from its neighbours), patches 3×3, 5×5, 7×7 and 15×15.
   std::mt19937 random(29);
-  const RandomRig rig = random_rig(6, 0.35, 0.4, random);
-  const auto views = make_photo_views(rig.cameras, pointers(rig.images));
-  const std::vector<std::uint16_t> all{0, 1, 2, 3, 4, 5};
+  const auto& [rig, views, all] = SixViewRig(random);
   std::uniform_real_distribution<double> coordinate(-0.7, 0.7);
   SurfacePatchLayout layout;
   double worst = 0;
@@ -831,6 +840,69 @@ TEST(SurfacePatch, EqualsTheDoubleReferenceOnRandomImages) {
   EXPECT_GT(compared, 300);
   std::printf("[measured] surface patches on random images: largest relative difference from the double "
               "reference %.2g (%d points)\n", worst, compared);
+}
+
+// Every build's surface_samples against one surface evaluation per sample of that build and
+// against the baseline build: bit for bit, slot by slot (only slot 0 when g(X) is undefined).
+void expect_samples_bits(const Eigen::Vector3d& X, double spacing, int half, const SurfacePatchLayout& layout,
+                         const std::vector<PhotoView>& views, const std::string& where) {
+  const auto builds = detail::photo_kernel_builds();
+  std::vector<PhotoValue> baseline(static_cast<std::size_t>(6 * half + 1)), samples(baseline.size());
+  builds.front().surface_samples(X, spacing, half, layout, views, baseline);
+  for (const auto& build : builds) {
+    std::fill(samples.begin(), samples.end(), PhotoValue{-1.0, -1});
+    build.surface_samples(X, spacing, half, layout, views, samples);
+    for_each_gradient_sample(X, spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
+      const PhotoValue one = build.surface(point, layout, views);
+      EXPECT_EQ(samples[slot].views, one.views) << build.name << " slot " << slot << where;
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(samples[slot].g), std::bit_cast<std::uint64_t>(one.g))
+          << build.name << " slot " << slot << ": " << samples[slot].g << " against " << one.g << where;
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(samples[slot].g), std::bit_cast<std::uint64_t>(baseline[slot].g))
+          << build.name << " against baseline, slot " << slot << where;
+      return samples[0].defined();
+    });
+  }
+}
+
+TEST(SurfacePatch, SamplesAcrossTheLanesGiveTheBitsOfOneEvaluationPerSample) {
+  // The AVX-512 build runs the gradient's 61 samples across its lanes when every view spreads them
+  // over less than 3 pixels (one 5×5-pixel window per point and view), else one evaluation per
+  // sample: on random images, patches 3×3 to 7×7, points near the images' borders (some samples'
+  // patches leave some images), spacings that put the samples within 3 pixels, near 3 and beyond.
+  std::mt19937 random(37);
+  const auto& [rig, views, all] = SixViewRig(random);
+  std::uniform_real_distribution<double> coordinate(-0.7, 0.7);
+  const int half = PhotoGradientOptions{}.savitzky_golay.half_window();
+  SurfacePatchLayout layout;
+  int narrow = 0, wide = 0, near_the_limit = 0, defined = 0;
+  for (int h : {1, 2, 3})
+    for (const double spacing : {0.001, 0.004, 0.007, 0.008, 0.009, 0.02})
+      for (int trial = 0; trial < 40; ++trial) {
+        const Eigen::Vector3d X(coordinate(random), coordinate(random), coordinate(random));
+        layout_surface_patch(X, random_normal(random), all, views, h, 1.5, layout);
+        // The samples' spread in pixels over the laid-out views.
+        double spread = 0;
+        for (const std::uint16_t k : layout.views) {
+          double low[2] = {INFINITY, INFINITY}, high[2] = {-INFINITY, -INFINITY};
+          for_each_gradient_sample(X, spacing, half, [&](std::size_t, const Eigen::Vector3d& point) {
+            const Projection p = rig.cameras[k].project(point);
+            low[0] = std::min(low[0], p.u), high[0] = std::max(high[0], p.u);
+            low[1] = std::min(low[1], p.v), high[1] = std::max(high[1], p.v);
+            return true;
+          });
+          spread = std::max({spread, high[0] - low[0], high[1] - low[1]});
+        }
+        narrow += spread < 2.5, wide += spread > 3.5, near_the_limit += spread >= 2.5 && spread <= 3.5;
+        defined += surface_patch_consistency(X, layout, views).defined();
+        expect_samples_bits(X, spacing, half, layout, views,
+                            " (h " + std::to_string(h) + ", spacing " + std::to_string(spacing) + ")");
+        if (HasFailure()) return;
+      }
+  EXPECT_GT(narrow, 100);
+  EXPECT_GT(near_the_limit, 50);
+  EXPECT_GT(wide, 100);
+  EXPECT_GT(defined, 300);
+  std::printf("[measured] samples spread over < 2.5 px: %d, 2.5–3.5 px: %d, > 3.5 px: %d\n", narrow, near_the_limit, wide);
 }
 
 TEST(SurfacePatch, ReadsTheImagesLastPixelWithoutPassingIt) {
@@ -875,6 +947,9 @@ TEST(SurfacePatch, ReadsTheImagesLastPixelWithoutPassingIt) {
       EXPECT_NEAR(fast.g, slow.g, 1e-6 + 1e-5 * slow.g) << build.name;
     }
     EXPECT_EQ(slow.views, 2);
+    // The gradient's samples within a pixel: AVX-512 reads their 5×5-pixel windows, moved inside
+    // the image at its corner.
+    expect_samples_bits(X, 1e-4, 10, layout, views, " at the last pixel");
   }
   EXPECT_EQ(at_last_pixel, 3);
 }

@@ -49,10 +49,9 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
       detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
     } else if (photo.surface_patch) {
       layout_surface_patch(X, fields.normal[v], visible, views, photo.half_patch, photo.surface_patch_spacing, layout);
-      for_each_gradient_sample(X, sample_spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
-        samples[slot] = surface_patch_consistency(point, layout, views);
-        return samples[0].defined();
-      });
+      // The next vertex's rows travel to the cache while this one's samples run.
+      if (v + 1 < vertices.end) prefetch_surface_patches(position(v + 1), layout, views);
+      surface_patch_samples(X, sample_spacing, half, layout, views, samples);
     } else if (photo.normalize) {
       // One map per view, taken at X, for every sample: g stays smooth along the sample lines.
       gain_bias_at(X, visible, views, photo.half_patch, photo.noise_floor, maps);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
@@ -24,6 +25,7 @@ namespace baseline {
 constexpr int kLanes = 2;  // two doubles per register: SSE2 on x86-64, the portable vectors elsewhere (arm64)
 #include "stages/flow/photo_kernel_body.inc"
 #include "stages/flow/surface_patch_kernel_body.inc"
+#include "stages/flow/surface_patch_samples_body.inc"
 }  // namespace baseline
 
 #ifdef MVFLOW_KERNEL_X86
@@ -34,6 +36,7 @@ namespace avx2 {
 constexpr int kLanes = 4;  // four doubles per ymm register
 #include "stages/flow/photo_kernel_body.inc"
 #include "stages/flow/surface_patch_kernel_body.inc"
+#include "stages/flow/surface_patch_samples_body.inc"
 }  // namespace avx2
 #undef MVFLOW_KERNEL_AVX2
 #pragma GCC pop_options
@@ -49,6 +52,7 @@ namespace avx512 {
 constexpr int kLanes = 8;  // eight doubles per zmm register
 #include "stages/flow/photo_kernel_body.inc"
 #include "stages/flow/surface_patch_kernel_body.inc"
+#include "stages/flow/surface_patch_samples_body.inc"
 }  // namespace avx512
 #undef MVFLOW_KERNEL_AVX512
 #pragma GCC diagnostic pop
@@ -117,14 +121,14 @@ void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> v
 std::vector<PhotoKernelBuild> photo_kernel_builds() {
   std::vector<PhotoKernelBuild> builds{
       {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_samples,
-       &baseline::surface_patch_consistency}};
+       &baseline::surface_patch_consistency, &baseline::surface_patch_samples}};
 #ifdef MVFLOW_KERNEL_X86
   if (__builtin_cpu_supports("x86-64-v3"))
     builds.push_back({"avx2", &avx2::photo_consistency_5x5, &avx2::photo_consistency_5x5_samples,
-                      &avx2::surface_patch_consistency});
+                      &avx2::surface_patch_consistency, &avx2::surface_patch_samples});
   if (__builtin_cpu_supports("x86-64-v4"))
     builds.push_back({"avx512", &avx512::photo_consistency_5x5, &avx512::photo_consistency_5x5_samples,
-                      &avx512::surface_patch_consistency});
+                      &avx512::surface_patch_consistency, &avx512::surface_patch_samples});
 #endif
   return builds;
 }

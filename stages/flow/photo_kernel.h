@@ -52,6 +52,9 @@ struct PhotoKernelBuild {
                   std::span<PhotoValue>);
   //! surface_patch_consistency() (stages/flow/surface_patch.h)
   PhotoValue (*surface)(const Eigen::Vector3d&, const SurfacePatchLayout&, const std::vector<PhotoView>&);
+  //! surface_patch_samples() (stages/flow/surface_patch.h)
+  void (*surface_samples)(const Eigen::Vector3d&, double, int, const SurfacePatchLayout&, const std::vector<PhotoView>&,
+                          std::span<PhotoValue>);
 };
 //! The builds this CPU can run, baseline first.
 std::vector<PhotoKernelBuild> photo_kernel_builds();

@@ -80,6 +80,33 @@ PhotoValue surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatc
   return detail::active_photo_kernel().surface(X, layout, views);
 }
 
+void surface_patch_samples(const Eigen::Vector3d& X, double spacing, int half, const SurfacePatchLayout& layout,
+                           const std::vector<PhotoView>& views, std::span<PhotoValue> samples) {
+  MVFLOW_CHECK(samples.size() >= static_cast<std::size_t>(6 * half + 1), "surface_patch_samples: too few samples");
+  detail::active_photo_kernel().surface_samples(X, spacing, half, layout, views, samples);
+}
+
+void prefetch_surface_patches(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
+                              const std::vector<PhotoView>& views) {
+  for (std::size_t k = 0; k < layout.views.size(); ++k) {
+    const PhotoView& view = views[layout.views[k]];
+    const Projection centre = view.project(X);
+    if (!(centre.depth > 0)) continue;
+    // The patch's box and its samples' reach (a pixel or two) on every side.
+    const float* bounds = layout.bounds.data() + 4 * k;
+    const double margin = 3;
+    const double left = centre.u + bounds[0] - margin, right = centre.u + bounds[1] + margin;
+    const double top = centre.v + bounds[2] - margin, bottom = centre.v + bounds[3] + margin;
+    if (!(left >= 0 && top >= 0 && right <= view.width - 1 && bottom <= view.height - 1)) continue;
+    const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
+    const auto x_first = static_cast<std::size_t>(left), x_last = static_cast<std::size_t>(right);
+    for (auto y = static_cast<std::size_t>(top); y <= static_cast<std::size_t>(bottom); ++y) {
+      const float* row = view.image->data() + y * stride;
+      for (std::size_t x = x_first; x <= x_last + 5; x += 5) __builtin_prefetch(row + std::min(x, x_last) * 3);  // 60 bytes apart
+    }
+  }
+}
+
 PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
                                         std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
                                         const PhotoConsistencyOptions& options, SurfacePatchLayout& layout) {
