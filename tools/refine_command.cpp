@@ -104,7 +104,7 @@ void add_refine_command(CLI::App& app, Runner& runner) {
                 "--keep-inside-silhouettes uses them, instead of thresholded photographs");
   c->add_option("--preset", args->preset,
                 "Parameter set: default, accurate (surface patches, --settle-tolerance 0.001: lower error, "
-                "1.6-2.3x the time) or thesis (exactly the thesis's B.7 values)")
+                "1.2-1.8x the time with AVX-512, 1.8-2.5x with AVX2) or thesis (exactly the thesis's B.7 values)")
       ->check(CLI::IsMember({"default", "accurate", "thesis"}))
       ->capture_default_str();
   c->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber)->capture_default_str();

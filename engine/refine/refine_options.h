@@ -116,7 +116,7 @@ RefineOptions default_preset();
 RefineOptions thesis_preset();
 //! The default preset with surface patches (PhotoConsistencyOptions::surface_patch) and the
 //! settled tolerance 0.001: lower error on 11 of 15 textured scenes and on both photograph sets,
-//! 1.6–2.3× the time of a default run (README "Surface patches").
+//! 1.2–1.8× the time of a default run with the AVX-512 build, 1.8–2.5× with AVX2 (README "Surface patches").
 RefineOptions accurate_preset();
 //! "default", "accurate" or "thesis". \throw InputError otherwise.
 RefineOptions preset(const std::string& name);
