@@ -809,6 +809,8 @@ TEST(SurfacePatch, EqualsTheExactProjectionOfItsTangentPoints) {
 struct SixViewRig {
   explicit SixViewRig(std::mt19937& random)
       : rig(random_rig(6, 0.35, 0.4, random)), views(make_photo_views(rig.cameras, pointers(rig.images))) {}
+  SixViewRig(const SixViewRig&) = delete;  // views point into rig.images
+  SixViewRig& operator=(const SixViewRig&) = delete;
   RandomRig rig;
   std::vector<PhotoView> views;
   std::vector<std::uint16_t> all{0, 1, 2, 3, 4, 5};
@@ -865,44 +867,83 @@ void expect_samples_bits(const Eigen::Vector3d& X, double spacing, int half, con
 }
 
 TEST(SurfacePatch, SamplesAcrossTheLanesGiveTheBitsOfOneEvaluationPerSample) {
-  // The AVX-512 build runs the gradient's 61 samples across its lanes when every view spreads them
+  // The AVX-512 build runs the gradient's samples across its lanes when every view spreads them
   // over less than 3 pixels (one 5×5-pixel window per point and view), else one evaluation per
   // sample: on random images, patches 3×3 to 7×7, points near the images' borders (some samples'
-  // patches leave some images), spacings that put the samples within 3 pixels, near 3 and beyond.
+  // patches leave some images), spacings that put the samples within 3 pixels, near 3 and beyond,
+  // Savitzky–Golay half windows of 1, 10 (the default) and 11 (more samples than the stack buffers
+  // hold), and points at an image's border within the samples' reach. The across-lanes path is also
+  // called alone, to count where it ran.
   std::mt19937 random(37);
   const auto& [rig, views, all] = SixViewRig(random);
   std::uniform_real_distribution<double> coordinate(-0.7, 0.7);
-  const int half = PhotoGradientOptions{}.savitzky_golay.half_window();
+  const int default_half = PhotoGradientOptions{}.savitzky_golay.half_window();
+  const auto across_lanes = detail::photo_kernel_builds().back().surface_samples_across_lanes;
   SurfacePatchLayout layout;
-  int narrow = 0, wide = 0, near_the_limit = 0, defined = 0;
-  for (int h : {1, 2, 3})
-    for (const double spacing : {0.001, 0.004, 0.007, 0.008, 0.009, 0.02})
-      for (int trial = 0; trial < 40; ++trial) {
-        const Eigen::Vector3d X(coordinate(random), coordinate(random), coordinate(random));
-        layout_surface_patch(X, random_normal(random), all, views, h, 1.5, layout);
-        // The samples' spread in pixels over the laid-out views.
-        double spread = 0;
-        for (const std::uint16_t k : layout.views) {
-          double low[2] = {INFINITY, INFINITY}, high[2] = {-INFINITY, -INFINITY};
-          for_each_gradient_sample(X, spacing, half, [&](std::size_t, const Eigen::Vector3d& point) {
-            const Projection p = rig.cameras[k].project(point);
-            low[0] = std::min(low[0], p.u), high[0] = std::max(high[0], p.u);
-            low[1] = std::min(low[1], p.v), high[1] = std::max(high[1], p.v);
-            return true;
-          });
-          spread = std::max({spread, high[0] - low[0], high[1] - low[1]});
-        }
-        narrow += spread < 2.5, wide += spread > 3.5, near_the_limit += spread >= 2.5 && spread <= 3.5;
-        defined += surface_patch_consistency(X, layout, views).defined();
-        expect_samples_bits(X, spacing, half, layout, views,
-                            " (h " + std::to_string(h) + ", spacing " + std::to_string(spacing) + ")");
-        if (HasFailure()) return;
-      }
+  int narrow = 0, wide = 0, near_the_limit = 0, defined = 0, ran_across = 0, mixed_views = 0;
+  const auto check = [&](const Eigen::Vector3d& X, const Eigen::Vector3d& N, int h, double spacing, int half) {
+    layout_surface_patch(X, N, all, views, h, 1.5, layout);
+    // The samples' spread in pixels over the laid-out views.
+    double spread = 0;
+    for (const std::uint16_t k : layout.views) {
+      double low[2] = {INFINITY, INFINITY}, high[2] = {-INFINITY, -INFINITY};
+      for_each_gradient_sample(X, spacing, half, [&](std::size_t, const Eigen::Vector3d& point) {
+        const Projection p = rig.cameras[k].project(point);
+        low[0] = std::min(low[0], p.u), high[0] = std::max(high[0], p.u);
+        low[1] = std::min(low[1], p.v), high[1] = std::max(high[1], p.v);
+        return true;
+      });
+      spread = std::max({spread, high[0] - low[0], high[1] - low[1]});
+    }
+    narrow += spread < 2.5, wide += spread > 3.5, near_the_limit += spread >= 2.5 && spread <= 3.5;
+    defined += surface_patch_consistency(X, layout, views).defined();
+    const std::string where =
+        " (h " + std::to_string(h) + ", spacing " + std::to_string(spacing) + ", half " + std::to_string(half) + ")";
+    expect_samples_bits(X, spacing, half, layout, views, where);
+    if (across_lanes == nullptr) return;
+    std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
+    if (!across_lanes(X, spacing, half, layout, views, samples)) return;
+    ++ran_across;
+    // Samples that use different numbers of views: the lanes' masks at work.
+    mixed_views += std::ranges::any_of(samples, [&](const PhotoValue& p) { return p.views != samples[0].views; });
+    for_each_gradient_sample(X, spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
+      const PhotoValue one = surface_patch_consistency(point, layout, views);
+      EXPECT_EQ(samples[slot].views, one.views) << "slot " << slot << where;
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(samples[slot].g), std::bit_cast<std::uint64_t>(one.g)) << "slot " << slot << where;
+      return true;
+    });
+  };
+  for (const int half : {default_half, 1, 11})
+    for (int h : {1, 2, 3}) {
+      if (half != default_half && h != 2) continue;
+      for (const double spacing : {0.001, 0.004, 0.007, 0.008, 0.009, 0.02})
+        for (int trial = 0; trial < 40 && !HasFailure(); ++trial)
+          check(Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random)), random_normal(random), h,
+                spacing, half);
+    }
+  // Points whose patch meets an image's border within the samples' reach, so that some samples can
+  // use that view and others cannot.
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int trial = 0; trial < 120 && !HasFailure(); ++trial) {
+    const Camera& camera = rig.cameras[static_cast<std::size_t>(trial % 6)];
+    const double edge = 0.5 + 2.5 * unit(random);  // pixels from the left or the top border
+    const bool left = trial % 12 < 6;
+    const Ray ray = camera.ray(left ? edge : 5 + 50 * unit(random), left ? 5 + 38 * unit(random) : edge);
+    check(ray.origin + 3.0 * ray.direction, random_normal(random), 1, 0.004, default_half);
+  }
   EXPECT_GT(narrow, 100);
   EXPECT_GT(near_the_limit, 50);
   EXPECT_GT(wide, 100);
   EXPECT_GT(defined, 300);
   std::printf("[measured] samples spread over < 2.5 px: %d, 2.5–3.5 px: %d, > 3.5 px: %d\n", narrow, near_the_limit, wide);
+  if (across_lanes == nullptr) {
+    std::printf("[measured] this CPU has no AVX-512 build: the across-lanes path was not run\n");
+  } else {
+    std::printf("[measured] across the lanes: %d evaluations, %d with samples on different view counts\n", ran_across,
+                mixed_views);
+    EXPECT_GT(ran_across, 200);
+    EXPECT_GT(mixed_views, 20);
+  }
 }
 
 TEST(SurfacePatch, ReadsTheImagesLastPixelWithoutPassingIt) {

@@ -50,7 +50,7 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     } else if (photo.surface_patch) {
       layout_surface_patch(X, fields.normal[v], visible, views, photo.half_patch, photo.surface_patch_spacing, layout);
       // The next vertex's rows travel to the cache while this one's samples run.
-      if (v + 1 < vertices.end) prefetch_surface_patches(position(v + 1), layout, views);
+      if (v + 1 < vertices.end) detail::prefetch_surface_patches(position(v + 1), layout, views);
       surface_patch_samples(X, sample_spacing, half, layout, views, samples);
     } else if (photo.normalize) {
       // One map per view, taken at X, for every sample: g stays smooth along the sample lines.

@@ -108,27 +108,31 @@ void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> v
     const double u = x.x() / x.z(), v = x.y() / x.z();
     if (!(x.z() > 0) || !view.patch_inside(u, v, 2)) continue;
     // The 6×6 block and a margin of 2 pixels on every side, where nearby samples read.
-    const int x_first = std::max(static_cast<int>(u) - 4, 0), x_last = std::min(static_cast<int>(u) + 5, view.width - 1);
-    const int y_first = std::max(static_cast<int>(v) - 4, 0), y_last = std::min(static_cast<int>(v) + 5, view.height - 1);
-    const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
-    for (int y = y_first; y <= y_last; ++y) {
-      const float* row = view.image->data() + static_cast<std::size_t>(y) * stride;
-      for (int x = x_first; x <= x_last + 5; x += 5) __builtin_prefetch(row + std::min(x, x_last) * 3);  // 60 bytes apart
-    }
+    prefetch_pixels(view, std::max(static_cast<int>(u) - 4, 0), std::min(static_cast<int>(u) + 5, view.width - 1),
+                    std::max(static_cast<int>(v) - 4, 0), std::min(static_cast<int>(v) + 5, view.height - 1));
+  }
+}
+
+void prefetch_pixels(const PhotoView& view, int x_first, int x_last, int y_first, int y_last) {
+  const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
+  for (int y = y_first; y <= y_last; ++y) {
+    const float* row = view.image->data() + static_cast<std::size_t>(y) * stride;
+    for (int x = x_first; x <= x_last + 5; x += 5) __builtin_prefetch(row + std::min(x, x_last) * 3);  // 60 bytes apart
   }
 }
 
 std::vector<PhotoKernelBuild> photo_kernel_builds() {
   std::vector<PhotoKernelBuild> builds{
       {"baseline", &baseline::photo_consistency_5x5, &baseline::photo_consistency_5x5_samples,
-       &baseline::surface_patch_consistency, &baseline::surface_patch_samples}};
+       &baseline::surface_patch_consistency, &baseline::surface_patch_samples, nullptr}};
 #ifdef MVFLOW_KERNEL_X86
   if (__builtin_cpu_supports("x86-64-v3"))
     builds.push_back({"avx2", &avx2::photo_consistency_5x5, &avx2::photo_consistency_5x5_samples,
-                      &avx2::surface_patch_consistency, &avx2::surface_patch_samples});
+                      &avx2::surface_patch_consistency, &avx2::surface_patch_samples, nullptr});
   if (__builtin_cpu_supports("x86-64-v4"))
     builds.push_back({"avx512", &avx512::photo_consistency_5x5, &avx512::photo_consistency_5x5_samples,
-                      &avx512::surface_patch_consistency, &avx512::surface_patch_samples});
+                      &avx512::surface_patch_consistency, &avx512::surface_patch_samples,
+                      &avx512::surface_samples_across_lanes});
 #endif
   return builds;
 }

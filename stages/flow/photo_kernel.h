@@ -44,6 +44,10 @@ void photo_consistency_5x5_samples(const Eigen::Vector3d& X, double spacing, int
 void prefetch_patches(const Eigen::Vector3d& X, std::span<const std::uint16_t> view_ids,
                       const std::vector<PhotoView>& views);
 
+//! Starts loading into the cache the pixels x_first..x_last of the rows y_first..y_last of
+//! \p view's image (all inside the image).
+void prefetch_pixels(const PhotoView& view, int x_first, int x_last, int y_first, int y_last);
+
 //! One build of the kernels, for tests that check that the builds agree bit for bit.
 struct PhotoKernelBuild {
   const char* name;  //!< "baseline", "avx2" or "avx512"
@@ -55,6 +59,11 @@ struct PhotoKernelBuild {
   //! surface_patch_samples() (stages/flow/surface_patch.h)
   void (*surface_samples)(const Eigen::Vector3d&, double, int, const SurfacePatchLayout&, const std::vector<PhotoView>&,
                           std::span<PhotoValue>);
+  //! surface_patch_samples()'s samples across the lanes alone (the AVX-512 build; nullptr in the
+  //! others): false, nothing written, where it would fall back to one evaluation per sample. For
+  //! tests that must know that path ran.
+  bool (*surface_samples_across_lanes)(const Eigen::Vector3d&, double, int, const SurfacePatchLayout&,
+                                       const std::vector<PhotoView>&, std::span<PhotoValue>);
 };
 //! The builds this CPU can run, baseline first.
 std::vector<PhotoKernelBuild> photo_kernel_builds();

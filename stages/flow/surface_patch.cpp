@@ -86,8 +86,8 @@ void surface_patch_samples(const Eigen::Vector3d& X, double spacing, int half, c
   detail::active_photo_kernel().surface_samples(X, spacing, half, layout, views, samples);
 }
 
-void prefetch_surface_patches(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
-                              const std::vector<PhotoView>& views) {
+void detail::prefetch_surface_patches(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
+                                      const std::vector<PhotoView>& views) {
   for (std::size_t k = 0; k < layout.views.size(); ++k) {
     const PhotoView& view = views[layout.views[k]];
     const Projection centre = view.project(X);
@@ -98,12 +98,7 @@ void prefetch_surface_patches(const Eigen::Vector3d& X, const SurfacePatchLayout
     const double left = centre.u + bounds[0] - margin, right = centre.u + bounds[1] + margin;
     const double top = centre.v + bounds[2] - margin, bottom = centre.v + bounds[3] + margin;
     if (!(left >= 0 && top >= 0 && right <= view.width - 1 && bottom <= view.height - 1)) continue;
-    const std::size_t stride = static_cast<std::size_t>(view.width) * 3;
-    const auto x_first = static_cast<std::size_t>(left), x_last = static_cast<std::size_t>(right);
-    for (auto y = static_cast<std::size_t>(top); y <= static_cast<std::size_t>(bottom); ++y) {
-      const float* row = view.image->data() + y * stride;
-      for (std::size_t x = x_first; x <= x_last + 5; x += 5) __builtin_prefetch(row + std::min(x, x_last) * 3);  // 60 bytes apart
-    }
+    prefetch_pixels(view, static_cast<int>(left), static_cast<int>(right), static_cast<int>(top), static_cast<int>(bottom));
   }
 }
 

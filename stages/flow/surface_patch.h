@@ -58,15 +58,18 @@ PhotoValue surface_patch_consistency(const Eigen::Vector3d& X, const SurfacePatc
 //! The gradient stage's 6·half + 1 samples of g with the laid-out patch, in the slots of
 //! for_each_gradient_sample(X, spacing, half, ...): each the same bits as
 //! surface_patch_consistency() at that sample (when g(X) is undefined, only samples[0] is
-//! certain to be written). With AVX2 and AVX-512 the samples run across the lanes, each point's
-//! 4×4-pixel window read once per view (stages/flow/surface_patch_samples_body.inc).
+//! certain to be written). In the AVX-512 build the samples run across the lanes, one 5×5-pixel
+//! window per point and view (stages/flow/surface_patch_samples_body.inc); the other builds, and
+//! that one where some view spreads the samples over 3 pixels or more, evaluate them one by one.
 void surface_patch_samples(const Eigen::Vector3d& X, double spacing, int half, const SurfacePatchLayout& layout,
                            const std::vector<PhotoView>& views, std::span<PhotoValue> samples);
 
+namespace detail {
 //! Starts loading into the cache the image rows that the surface patches of a point \p X near the
 //! laid-out one read (with its samples), so that evaluating there next does not wait for memory.
 void prefetch_surface_patches(const Eigen::Vector3d& X, const SurfacePatchLayout& layout,
                               const std::vector<PhotoView>& views);
+}  // namespace detail
 
 //! g at the surface point \p X with outward unit normal \p N as the options say: the surface
 //! patch (laid out in \p layout, reused between calls) when options.surface_patch, else
