@@ -108,6 +108,21 @@ TEST(RefinePresets, AccurateIsTheDefaultWithSurfacePatchesAndTheFinerSettledTole
   EXPECT_THROW(preset("fast"), InputError);
 }
 
+// The one list the command line checks against and the error names: every name resolves to a
+// valid preset, and an unknown one is refused with all of them listed.
+TEST(RefinePresets, EveryListedNameResolvesAndAnUnknownOneListsThemAll) {
+  EXPECT_EQ(preset_names(), (std::vector<std::string>{"default", "accurate", "thesis"}));
+  for (const std::string& name : preset_names()) EXPECT_NO_THROW(preset(name).check()) << name;
+  try {
+    preset("fast");
+    FAIL() << "an unknown preset was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown preset 'fast' (expected one of: default, accurate, thesis)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RefineOptionTable, EveryEntryIsCovered) {
   EXPECT_EQ(cases().size(), refine_option_table().size());
   for (const RefineOptionEntry& entry : refine_option_table())

@@ -211,7 +211,7 @@ void add_batch_command(CLI::App& app, Runner& runner) {
           "i/n"))
       ->capture_default_str();
   c->add_option("--preset", args->preset, "default, accurate or thesis (as refine's)")
-      ->check(CLI::IsMember({"default", "accurate", "thesis"}))
+      ->check(CLI::IsMember(preset_names()))
       ->capture_default_str();
   c->add_option("--threads", args->threads, "Threads per refinement (0 = all cores)")->capture_default_str();
   c->add_option("--masks", args->masks,

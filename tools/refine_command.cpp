@@ -105,7 +105,7 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--preset", args->preset,
                 "Parameter set: default, accurate (surface patches, --settle-tolerance 0.001: lower error, "
                 "1.2-1.8x the time with AVX-512, 1.8-2.5x with AVX2) or thesis (exactly the thesis's B.7 values)")
-      ->check(CLI::IsMember({"default", "accurate", "thesis"}))
+      ->check(CLI::IsMember(preset_names()))
       ->capture_default_str();
   c->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber)->capture_default_str();
   add_refine_options(*c);  // every RefineOptions field, from tools/refine_option_table

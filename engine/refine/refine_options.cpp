@@ -67,11 +67,18 @@ RefineOptions accurate_preset() {
   return options;
 }
 
+const std::vector<std::string>& preset_names() {
+  static const std::vector<std::string> names{"default", "accurate", "thesis"};
+  return names;
+}
+
 RefineOptions preset(const std::string& name) {
   if (name == "default") return default_preset();
   if (name == "accurate") return accurate_preset();
   if (name == "thesis") return thesis_preset();
-  throw InputError("unknown preset '" + name + "' (expected default, accurate or thesis)");
+  std::string expected;
+  for (const std::string& known : preset_names()) expected += (expected.empty() ? "" : ", ") + known;
+  throw InputError("unknown preset '" + name + "' (expected one of: " + expected + ")");
 }
 
 }  // namespace mvflow

@@ -118,7 +118,9 @@ RefineOptions thesis_preset();
 //! settled tolerance 0.001: lower error on 11 of 15 textured scenes and on both photograph sets,
 //! 1.2–1.8× the time of a default run with the AVX-512 build, 1.8–2.5× with AVX2 (README "Surface patches").
 RefineOptions accurate_preset();
-//! "default", "accurate" or "thesis". \throw InputError otherwise.
+//! The presets' names, in the order help texts list them: default, accurate, thesis.
+const std::vector<std::string>& preset_names();
+//! The preset named `name` (one of preset_names()). \throw InputError otherwise.
 RefineOptions preset(const std::string& name);
 
 }  // namespace mvflow
