@@ -14,16 +14,6 @@ namespace mvflow {
 
 namespace {
 
-// Embree's instruction-set paths differ in their last bits, and on a tangled mesh a ray grazing
-// an edge is then blocked on one machine and not on another. Capping every build at AVX2 (what
-// most machines have; about 1 % of a run against AVX-512) makes AVX2 and AVX-512 machines trace
-// the same rays; a baseline build forced with MVFLOW_KERNEL runs as on an SSE2-only machine.
-std::string embree_config() {
-  const char* forced = std::getenv("MVFLOW_KERNEL");
-  if (forced != nullptr && std::string(forced) == "baseline") return "max_isa=sse2";
-  return "max_isa=avx2";
-}
-
 // Embree reports errors through a callback; we keep the last message and throw from the caller.
 struct DeviceErrors {
   std::mutex mutex;
@@ -82,17 +72,32 @@ struct SurfaceQuery::Embree {
 
 SurfaceQuery::SurfaceQuery(const TriMesh& mesh) : SurfaceQuery(positions_of(mesh), triangles_of(mesh)) {}
 
+std::string embree_device_config() {
+  // AVX2: what most machines have, about 1 % of a run against AVX-512 (SSE2 for all: 2–7 %).
+  // Embree's config files (.embree3 beside the program or in the home folder) are ignored: an
+  // `isa=` there would silently undo the cap.
+  const char* forced = std::getenv("MVFLOW_KERNEL");
+  const bool baseline = forced != nullptr && std::string(forced) == "baseline";
+  return std::string(baseline ? "max_isa=sse2" : "max_isa=avx2") + ",ignore_config_files=1";
+}
+
 SurfaceQuery::SurfaceQuery(const IndexedMesh& mesh) : SurfaceQuery(mesh.positions, mesh.triangles) {}
 
 SurfaceQuery::SurfaceQuery(const std::vector<Eigen::Vector3d>& positions,
                            const std::vector<std::array<std::uint32_t, 3>>& triangles)
+    : SurfaceQuery(positions, triangles, embree_device_config()) {}
+
+SurfaceQuery::SurfaceQuery(const IndexedMesh& mesh, const std::string& device_config)
+    : SurfaceQuery(mesh.positions, mesh.triangles, device_config) {}
+
+SurfaceQuery::SurfaceQuery(const std::vector<Eigen::Vector3d>& positions,
+                           const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::string& device_config)
     : positions_(positions), triangles_(triangles), embree_(std::make_unique<Embree>()) {
   if (triangles_.empty()) throw InputError("surface query: the mesh has no triangles");
   for (const auto& t : triangles_)
     for (auto v : t) MVFLOW_CHECK(v < positions_.size(), "triangle index out of range");
   Embree& e = *embree_;
-  const std::string config = embree_config();
-  e.device = rtcNewDevice(config.c_str());
+  e.device = rtcNewDevice(device_config.c_str());
   if (!e.device) throw Error("Embree: cannot create a device (unsupported CPU?)");
   rtcSetDeviceErrorFunction(e.device, on_embree_error, &e.errors);
   e.scene = rtcNewScene(e.device);

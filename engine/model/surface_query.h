@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "engine/model/mesh.h"
@@ -32,6 +33,12 @@ struct ClosestPoint {
   std::uint32_t face = 0;
 };
 
+//! Embree's device configuration for every SurfaceQuery: "max_isa=avx2", so that an AVX-512 machine
+//! traces rays by Embree's AVX2 path, as an AVX2 machine does (its paths differ in their last
+//! bits), or "max_isa=sse2" under MVFLOW_KERNEL=baseline; Embree's config files ignored (README
+//! "Performance").
+std::string embree_device_config();
+
 class SurfaceQuery {
  public:
   //! Builds the BVH. \p positions #V, \p triangles #F (indices into positions).
@@ -39,6 +46,9 @@ class SurfaceQuery {
   //! silently drop such triangles).
   SurfaceQuery(const std::vector<Eigen::Vector3d>& positions, const std::vector<std::array<std::uint32_t, 3>>& triangles);
   explicit SurfaceQuery(const IndexedMesh& mesh);
+  //! The same with Embree's device configuration (rtcNewDevice's string) given instead of
+  //! embree_device_config()'s, e.g. "" for the widest instruction set the CPU has.
+  SurfaceQuery(const IndexedMesh& mesh, const std::string& device_config);
   explicit SurfaceQuery(const TriMesh& mesh);
   ~SurfaceQuery();
   SurfaceQuery(const SurfaceQuery&) = delete;
@@ -60,6 +70,8 @@ class SurfaceQuery {
 
 
  private:
+  SurfaceQuery(const std::vector<Eigen::Vector3d>& positions, const std::vector<std::array<std::uint32_t, 3>>& triangles,
+               const std::string& device_config);
   struct Embree;
   std::vector<Eigen::Vector3d> positions_;
   std::vector<std::array<std::uint32_t, 3>> triangles_;

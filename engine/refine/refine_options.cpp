@@ -67,17 +67,31 @@ RefineOptions accurate_preset() {
   return options;
 }
 
+namespace {
+
+// Every preset, in the order help texts list them: the one list preset() and preset_names() read.
+struct NamedPreset {
+  const char* name;
+  RefineOptions (*make)();
+};
+constexpr NamedPreset kPresets[] = {{"default", default_preset}, {"accurate", accurate_preset}, {"thesis", thesis_preset}};
+
+}  // namespace
+
 const std::vector<std::string>& preset_names() {
-  static const std::vector<std::string> names{"default", "accurate", "thesis"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> list;
+    for (const NamedPreset& preset : kPresets) list.emplace_back(preset.name);
+    return list;
+  }();
   return names;
 }
 
 RefineOptions preset(const std::string& name) {
-  if (name == "default") return default_preset();
-  if (name == "accurate") return accurate_preset();
-  if (name == "thesis") return thesis_preset();
+  for (const NamedPreset& known : kPresets)
+    if (name == known.name) return known.make();
   std::string expected;
-  for (const std::string& known : preset_names()) expected += (expected.empty() ? "" : ", ") + known;
+  for (const NamedPreset& known : kPresets) expected += (expected.empty() ? "" : ", ") + std::string(known.name);
   throw InputError("unknown preset '" + name + "' (expected one of: " + expected + ")");
 }
 
