@@ -74,8 +74,9 @@ SurfaceQuery::SurfaceQuery(const TriMesh& mesh) : SurfaceQuery(positions_of(mesh
 
 std::string embree_device_config() {
   // AVX2: what most machines have, about 1 % of a run against AVX-512 (SSE2 for all: 2–7 %).
-  // Embree's config files (.embree3 beside the program or in the home folder) are ignored: an
-  // `isa=` there would silently undo the cap.
+  // Embree's config files (.embree3 beside the program or in the home folder) are ignored, so that
+  // none can set an instruction set (`isa=`) past the cap. (Debian's Embree 3.13.5 read neither in
+  // a check with `isa=sse2` in both places; other builds may.)
   const char* forced = std::getenv("MVFLOW_KERNEL");
   const bool baseline = forced != nullptr && std::string(forced) == "baseline";
   return std::string(baseline ? "max_isa=sse2" : "max_isa=avx2") + ",ignore_config_files=1";
