@@ -844,6 +844,21 @@ TEST(SurfacePatch, EqualsTheDoubleReferenceOnRandomImages) {
               "reference %.2g (%d points)\n", worst, compared);
 }
 
+// The gradient's samples against one evaluation per sample with `evaluate` (a build's
+// surface_patch_consistency), bit for bit, slot by slot: every slot, or only slot 0 when g(X) is
+// undefined and `every_slot` is false (where surface_samples need not write the others).
+template <typename Evaluate>
+void expect_each_slot_is_one_evaluation(const std::vector<PhotoValue>& samples, const Eigen::Vector3d& X, double spacing,
+                                        int half, Evaluate evaluate, bool every_slot, const std::string& where) {
+  for_each_gradient_sample(X, spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
+    const PhotoValue one = evaluate(point);
+    EXPECT_EQ(samples[slot].views, one.views) << "slot " << slot << where;
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(samples[slot].g), std::bit_cast<std::uint64_t>(one.g))
+        << "slot " << slot << ": " << samples[slot].g << " against " << one.g << where;
+    return every_slot || samples[0].defined();
+  });
+}
+
 // Every build's surface_samples against one surface evaluation per sample of that build and
 // against the baseline build: bit for bit, slot by slot (only slot 0 when g(X) is undefined).
 void expect_samples_bits(const Eigen::Vector3d& X, double spacing, int half, const SurfacePatchLayout& layout,
@@ -854,11 +869,11 @@ void expect_samples_bits(const Eigen::Vector3d& X, double spacing, int half, con
   for (const auto& build : builds) {
     std::fill(samples.begin(), samples.end(), PhotoValue{-1.0, -1});
     build.surface_samples(X, spacing, half, layout, views, samples);
-    for_each_gradient_sample(X, spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
-      const PhotoValue one = build.surface(point, layout, views);
-      EXPECT_EQ(samples[slot].views, one.views) << build.name << " slot " << slot << where;
-      EXPECT_EQ(std::bit_cast<std::uint64_t>(samples[slot].g), std::bit_cast<std::uint64_t>(one.g))
-          << build.name << " slot " << slot << ": " << samples[slot].g << " against " << one.g << where;
+    const std::string in_build = std::string(" in ") + build.name + where;
+    expect_each_slot_is_one_evaluation(
+        samples, X, spacing, half, [&](const Eigen::Vector3d& point) { return build.surface(point, layout, views); },
+        false, in_build);
+    for_each_gradient_sample(X, spacing, half, [&](std::size_t slot, const Eigen::Vector3d&) {
       EXPECT_EQ(std::bit_cast<std::uint64_t>(samples[slot].g), std::bit_cast<std::uint64_t>(baseline[slot].g))
           << build.name << " against baseline, slot " << slot << where;
       return samples[0].defined();
@@ -906,12 +921,10 @@ TEST(SurfacePatch, SamplesAcrossTheLanesGiveTheBitsOfOneEvaluationPerSample) {
     ++ran_across;
     // Samples that use different numbers of views: the lanes' masks at work.
     mixed_views += std::ranges::any_of(samples, [&](const PhotoValue& p) { return p.views != samples[0].views; });
-    for_each_gradient_sample(X, spacing, half, [&](std::size_t slot, const Eigen::Vector3d& point) {
-      const PhotoValue one = surface_patch_consistency(point, layout, views);
-      EXPECT_EQ(samples[slot].views, one.views) << "slot " << slot << where;
-      EXPECT_EQ(std::bit_cast<std::uint64_t>(samples[slot].g), std::bit_cast<std::uint64_t>(one.g)) << "slot " << slot << where;
-      return true;
-    });
+    expect_each_slot_is_one_evaluation(
+        samples, X, spacing, half,
+        [&](const Eigen::Vector3d& point) { return surface_patch_consistency(point, layout, views); }, true,
+        " across the lanes" + where);
   };
   for (const int half : {default_half, 1, 11})
     for (int h : {1, 2, 3}) {
