@@ -41,6 +41,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--observed-view-angle", {"60", 60.0}},
       {"--observed-erode", {"2", 2}},
       {"--hardly-observed", {"0.4", 0.4}},
+      {"--spread-unmoved", {"on", "on"}},
       {"--fill-unobserved", {"on", true}},
       {"--weak-view-angle", {"60", 60.0}},
       {"--fit-silhouettes", {"on", "on"}},

@@ -204,6 +204,13 @@ TEST(UnobservedDisplacement, UnobservedAreTheVerticesWithoutSpeedGrownByTheErode
     if (std::abs(cosine - 0.5) < 1e-9) continue;  // on the 60° circle
     EXPECT_EQ(facing[i], exact[i] || cosine < 0.5 ? 1 : 0) << i;
   }
+  // The observed set before the erosion is the complement, with either angle.
+  for (const double angle : {60.0, 90.0}) {
+    options.observed_angle_degrees = angle;
+    const std::vector<std::uint8_t> observed = observed_vertices(mesh, views, fields, options);
+    const std::vector<std::uint8_t> poor = poorly_observed_vertices(mesh, views, fields, options);
+    for (std::size_t i = 0; i < observed.size(); ++i) EXPECT_EQ(observed[i], 1 - poor[i]) << i << " at " << angle;
+  }
 }
 
 TEST(UnobservedDisplacement, VerticesOnTheSilhouettesCountAsObservedAndAreNotEroded) {

@@ -198,6 +198,12 @@ std::vector<RefineOptionEntry> make_table() {
                     "--spread-unobserved auto without fitted rims: only vertices that had a speed in at most this "
                     "fraction of their resolution's iterations follow the observed surface",
                     [](auto& o) -> auto& { return o.unobserved_displacement.hardly_observed_fraction; }));
+  t.push_back(choice("--spread-unmoved", "spread_unmoved",
+                     "--spread-unobserved on/auto: at the run's end the poorly observed vertices the finest resolution "
+                     "never gave a speed follow the observed surface too, and stay: on, off, or auto (where the rims "
+                     "are not fitted)",
+                     {{"off", UnobservedSpread::Off}, {"on", UnobservedSpread::On}, {"auto", UnobservedSpread::Auto}},
+                     [](auto& o) -> auto& { return o.unobserved_displacement.spread_unmoved; }));
   t.push_back(on_off("--fill-unobserved", "fill_unobserved",
                      "Vertices without g or ∇g move with their observed neighbours (on/off)",
                      [](auto& o) -> auto& { return o.unobserved.fill; }));

@@ -179,6 +179,8 @@ class Refinement {
     spread_fraction_ = options.unobserved_displacement.spread == UnobservedSpread::Auto && !data_.rim_masks
                            ? options.unobserved_displacement.hardly_observed_fraction
                            : 1.0;
+    const UnobservedSpread unmoved = options.unobserved_displacement.spread_unmoved;
+    spreads_unmoved_ = spreads_ && (unmoved == UnobservedSpread::On || (unmoved == UnobservedSpread::Auto && !data_.rim_masks));
     // Last, as when the mesh was prepared after the constructor: a bad mask or silhouette is
     // reported before a bad mesh.
     if (preparing_error) std::rethrow_exception(preparing_error);
@@ -257,7 +259,9 @@ class Refinement {
     // At convergence the spread runs before each refinement (refine_at_convergence); refined every
     // iteration, once here.
     if (status != RefineStatus::Cancelled && options_.refinement_schedule == RefinementSchedule::EveryIteration)
-      spread_unobserved();
+      spread_unobserved(spread_fraction_);
+    else if (status != RefineStatus::Cancelled && spreads_unmoved_)
+      spread_unobserved(0.0);
     const std::optional<UntanglingResult> untangled =
         status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
     summary.untangled_pairs = untangled_pairs_;
@@ -333,8 +337,9 @@ class Refinement {
   void count_observed() {
     if (!spreads_) return;
     ++level_iterations_;
-    for (std::size_t v = 0; v < speed_iterations_.size(); ++v)
-      if (data_.fields.defined[v] & kSpeedDefined) ++speed_iterations_[v];
+    const std::vector<std::uint8_t> observed =
+        observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement);
+    for (std::size_t v = 0; v < speed_iterations_.size(); ++v) speed_iterations_[v] += observed[v];
   }
 
   // Removes the folds of the current surface (UntanglingOptions), counted for the summary;
@@ -364,15 +369,16 @@ class Refinement {
   }
 
   // Moves the vertices the last iteration did not observe well with the observed surface
-  // (UnobservedDisplacementOptions); the fields still describe the current topology.
-  // True when vertices moved.
-  bool spread_unobserved() {
+  // (UnobservedDisplacementOptions), of those only the ones that had a speed in at most
+  // \p fraction of this resolution's iterations when it is below 1; the fields still describe
+  // the current topology. True when vertices moved.
+  bool spread_unobserved(double fraction) {
     if (!spreads_) return false;
     std::vector<std::uint8_t> poor =
         poorly_observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement, data_.on_rim);
     // Kept among those after their erosion: growing the hardly observed set by the ring instead
     // spread more of a bumpy object's underside (bumpy sphere 0.00173 → 0.00241).
-    if (spread_fraction_ < 1) keep_hardly_observed(poor, speed_iterations_, level_iterations_, spread_fraction_);
+    if (fraction < 1) keep_hardly_observed(poor, speed_iterations_, level_iterations_, fraction);
     const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const DisplacementResult result = spread_displacement(mesh_, reference_, poor);
     if (result.moved_vertices > 0) limit_to_silhouettes(before);
@@ -434,7 +440,7 @@ class Refinement {
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     const auto start = Clock::now();
     const std::vector<Eigen::Vector3d> flowed = spreads_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
-    const bool spread = spread_unobserved();
+    const bool spread = spread_unobserved(spread_fraction_);
     const std::optional<UntanglingResult> untangled = untangle_folds();
     if (spread || (untangled && untangled->rounds > 0)) update_curvature();  // the marks follow the moves
     double seconds = seconds_since(start);
@@ -499,6 +505,9 @@ class Refinement {
   double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
   std::size_t untangled_pairs_ = 0;
   bool rims_from_masks_ = false;  //!< the silhouettes are the scene's mask images (Scene::masks)
+  //! At the run's end the vertices the finest resolution never gave a speed follow too
+  //! (UnobservedDisplacementOptions::spread_unmoved).
+  bool spreads_unmoved_ = false;
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the ones with a speed in at most this fraction of the resolution's iterations
   //! (1: all; UnobservedDisplacementOptions::hardly_observed_fraction).

@@ -128,31 +128,38 @@ std::vector<std::uint8_t> grow_by_rings(const TriMesh& mesh, std::vector<std::ui
 
 }  // namespace
 
-std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
-                                                   const VertexFields& fields,
-                                                   const UnobservedDisplacementOptions& options,
-                                                   std::span<const std::uint8_t> on_silhouette) {
+std::vector<std::uint8_t> observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
+                                            const VertexFields& fields, const UnobservedDisplacementOptions& options) {
   options.check();
-  MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "poorly_observed_vertices: fields not sized for the mesh");
-  MVFLOW_CHECK(on_silhouette.empty() || on_silhouette.size() == fields.size(),
-               "poorly_observed_vertices: the silhouette flags are not sized for the mesh");
+  MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "observed_vertices: fields not sized for the mesh");
   const double cos_observed = std::cos(options.observed_angle_degrees * std::numbers::pi / 180.0);
-  std::vector<std::uint8_t> poor(fields.size(), 1);
+  std::vector<std::uint8_t> observed(fields.size(), 0);
   for (std::uint32_t v = 0; v < fields.size(); ++v) {
     if (!(fields.defined[v] & kSpeedDefined)) continue;
     if (options.observed_angle_degrees >= 90.0) {
-      poor[v] = 0;
+      observed[v] = 1;
       continue;
     }
     const Eigen::Vector3d p = position(mesh, TriMesh::VertexHandle(static_cast<int>(v)));
     for (const std::uint16_t id : fields.visible(v)) {
       const Eigen::Vector3d to_camera = views[id].camera->centre() - p;
       if (fields.normal[v].dot(to_camera) >= cos_observed * to_camera.norm()) {
-        poor[v] = 0;
+        observed[v] = 1;
         break;
       }
     }
   }
+  return observed;
+}
+
+std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
+                                                   const VertexFields& fields,
+                                                   const UnobservedDisplacementOptions& options,
+                                                   std::span<const std::uint8_t> on_silhouette) {
+  MVFLOW_CHECK(on_silhouette.empty() || on_silhouette.size() == fields.size(),
+               "poorly_observed_vertices: the silhouette flags are not sized for the mesh");
+  std::vector<std::uint8_t> poor = observed_vertices(mesh, views, fields, options);
+  for (std::uint8_t& flag : poor) flag = !flag;
   return grow_by_rings(mesh, poor, options.erode_rings, on_silhouette);
 }
 
