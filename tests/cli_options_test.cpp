@@ -41,6 +41,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--observed-view-angle", {"60", 60.0}},
       {"--observed-erode", {"2", 2}},
       {"--hardly-observed", {"0.4", 0.4}},
+      {"--hardly-observed-first", {"0.5", 0.5}},
       {"--spread-unmoved", {"on", "on"}},
       {"--fill-unobserved", {"on", true}},
       {"--weak-view-angle", {"60", 60.0}},
@@ -150,7 +151,7 @@ TEST(RefineOptionTable, EachFlagSetsItsOwnFieldAndNothingElse) {
 TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
-        {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"}}) {
+        {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"}, {"--hardly-observed-first", "-0.1"}}) {
     EXPECT_THROW(options_after(bad), CLI::ParseError) << bad[0] << " " << bad[1];
   }
 }

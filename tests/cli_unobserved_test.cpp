@@ -144,9 +144,11 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   // The cap (below −75°) ends nearer the sphere than without a spread.
   EXPECT_LT(cap_errors(folder / "auto.ply").cap, cap_errors(folder / "off.ply").cap);
 
-  // The spread at the end: one more spread than without it, after the last iteration; the cap
-  // nearer the sphere (measured 0.0134 → 0.0084), the band the views see as before (the spread
-  // moves no vertex the finest resolution gave a speed; the untangling after it a few).
+  // The spread at the end: one more spread than without it, after the last iteration, and it
+  // moves only vertices of the weakly seen caps (the run is the same until then, so the vertex
+  // ids match; measured: 388 vertices moved, none within ±45°). Whether that brings a cap nearer
+  // depends on the scene: on the fifteen of the README 0.988× the error, here this rig's cap
+  // below −75° 0.0091 → 0.0105 (README, "Weakly seen regions").
   const auto unmoved_off = test::run_mvflow("refine " + scene.string() + " -o " +
                                             (folder / "unmoved_off.ply").string() + " --spread-unmoved off");
   ASSERT_EQ(unmoved_off.exit_code, 0) << unmoved_off.output;
@@ -161,9 +163,30 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   EXPECT_GT(automatic.output.rfind("unobserved vertices with the observed surface"),
             automatic.output.rfind("] iteration "))
       << automatic.output;
-  const CapErrors at_end = cap_errors(folder / "auto.ply"), not_at_end = cap_errors(folder / "unmoved_off.ply");
-  EXPECT_LT(at_end.cap, 0.8 * not_at_end.cap);
-  EXPECT_NEAR(at_end.observed, not_at_end.observed, 0.02 * not_at_end.observed);
+  const IndexedMesh at_end = io::read_mesh(folder / "auto.ply"), not_at_end = io::read_mesh(folder / "unmoved_off.ply");
+  ASSERT_EQ(at_end.positions.size(), not_at_end.positions.size());
+  std::size_t moved_at_end = 0;
+  for (std::size_t v = 0; v < at_end.positions.size(); ++v) {
+    const Eigen::Vector3d& p = not_at_end.positions[v];
+    if (at_end.positions[v] == p) continue;
+    ++moved_at_end;
+    EXPECT_GT(std::abs(p.y() / p.norm()), std::sin(std::numbers::pi / 4)) << "vertex " << v << " moved at " << p.transpose();
+  }
+  EXPECT_GT(moved_at_end, 50u);
+
+  // The first resolution's spread takes the vertices with a speed in at most 3/4 of its
+  // iterations (--hardly-observed-first), a superset of those in at most 1/4 and a subset of
+  // all of them (`on`: the same set as a fraction of 1). Measured: 159, 247 and 432 vertices.
+  const auto first_moved = [&](const std::string& fraction) {
+    const auto r = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "first.ply").string() +
+                                    " --hardly-observed-first " + fraction);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return moved(r.output);
+  };
+  const long quarter = first_moved("0.25"), all = first_moved("1");
+  EXPECT_LT(quarter, moved(automatic.output));
+  EXPECT_LT(moved(automatic.output), all);
+  EXPECT_EQ(all, moved(on.output));
 }
 
 // `refine --masks`: silhouettes from files instead of thresholded photographs, so a textured

@@ -198,6 +198,10 @@ std::vector<RefineOptionEntry> make_table() {
                     "--spread-unobserved auto without fitted rims: only vertices that had a speed in at most this "
                     "fraction of their resolution's iterations follow the observed surface",
                     [](auto& o) -> auto& { return o.unobserved_displacement.hardly_observed_fraction; }));
+  t.push_back(value("--hardly-observed-first", "first_hardly_observed_fraction",
+                    "unobserved_displacement.first_hardly_observed_fraction",
+                    "--hardly-observed at the first resolution's convergence (the coarsest mesh)",
+                    [](auto& o) -> auto& { return o.unobserved_displacement.first_hardly_observed_fraction; }));
   t.push_back(choice("--spread-unmoved", "spread_unmoved",
                      "--spread-unobserved on/auto: at the run's end the poorly observed vertices the finest resolution "
                      "never gave a speed follow the observed surface too, and stay: on, off, or auto (where the rims "

@@ -440,7 +440,10 @@ class Refinement {
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     const auto start = Clock::now();
     const std::vector<Eigen::Vector3d> flowed = spreads_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
-    const bool spread = spread_unobserved(spread_fraction_);
+    // The first resolution's fraction applies before the first refinement (auto without rims).
+    const bool first = mesh_refinements_ == 0 && spread_fraction_ < 1;
+    const bool spread =
+        spread_unobserved(first ? options_.unobserved_displacement.first_hardly_observed_fraction : spread_fraction_);
     const std::optional<UntanglingResult> untangled = untangle_folds();
     if (spread || (untangled && untangled->rounds > 0)) update_curvature();  // the marks follow the moves
     double seconds = seconds_since(start);
@@ -453,6 +456,7 @@ class Refinement {
       if (spread) set_positions(mesh_, flowed);
       return false;
     }
+    ++mesh_refinements_;
     report.stop = std::string("refined (") + to_string(reason) + ")";
     data_.reset_topology();
     graph_.reset();
@@ -508,6 +512,7 @@ class Refinement {
   //! At the run's end the vertices the finest resolution never gave a speed follow too
   //! (UnobservedDisplacementOptions::spread_unmoved).
   bool spreads_unmoved_ = false;
+  int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the ones with a speed in at most this fraction of the resolution's iterations
   //! (1: all; UnobservedDisplacementOptions::hardly_observed_fraction).

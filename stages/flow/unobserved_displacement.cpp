@@ -22,6 +22,8 @@ void UnobservedDisplacementOptions::check() const {
   require_option(erode_rings >= 0 && erode_rings <= 100, "erode_rings", erode_rings, "[0, 100]");
   require_option(hardly_observed_fraction >= 0 && hardly_observed_fraction <= 1, "hardly_observed_fraction",
                  hardly_observed_fraction, "[0, 1]");
+  require_option(first_hardly_observed_fraction >= 0 && first_hardly_observed_fraction <= 1,
+                 "first_hardly_observed_fraction", first_hardly_observed_fraction, "[0, 1]");
 }
 
 namespace {
