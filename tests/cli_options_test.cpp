@@ -151,7 +151,8 @@ TEST(RefineOptionTable, EachFlagSetsItsOwnFieldAndNothingElse) {
 TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
-        {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"}, {"--hardly-observed-first", "-0.1"}}) {
+        {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"},
+        {"--hardly-observed-first", "-0.1"}}) {
     EXPECT_THROW(options_after(bad), CLI::ParseError) << bad[0] << " " << bad[1];
   }
 }

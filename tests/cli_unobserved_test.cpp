@@ -163,14 +163,16 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   EXPECT_GT(automatic.output.rfind("unobserved vertices with the observed surface"),
             automatic.output.rfind("] iteration "))
       << automatic.output;
-  const IndexedMesh at_end = io::read_mesh(folder / "auto.ply"), not_at_end = io::read_mesh(folder / "unmoved_off.ply");
+  const IndexedMesh at_end = io::read_mesh(folder / "auto.ply");
+  const IndexedMesh not_at_end = io::read_mesh(folder / "unmoved_off.ply");
   ASSERT_EQ(at_end.positions.size(), not_at_end.positions.size());
   std::size_t moved_at_end = 0;
   for (std::size_t v = 0; v < at_end.positions.size(); ++v) {
     const Eigen::Vector3d& p = not_at_end.positions[v];
     if (at_end.positions[v] == p) continue;
     ++moved_at_end;
-    EXPECT_GT(std::abs(p.y() / p.norm()), std::sin(std::numbers::pi / 4)) << "vertex " << v << " moved at " << p.transpose();
+    EXPECT_GT(std::abs(p.y() / p.norm()), std::sin(std::numbers::pi / 4))
+        << "vertex " << v << " moved at " << p.transpose();
   }
   EXPECT_GT(moved_at_end, 50u);
 

@@ -180,7 +180,8 @@ class Refinement {
                            ? options.unobserved_displacement.hardly_observed_fraction
                            : 1.0;
     const UnobservedSpread unmoved = options.unobserved_displacement.spread_unmoved;
-    spreads_unmoved_ = spreads_ && (unmoved == UnobservedSpread::On || (unmoved == UnobservedSpread::Auto && !data_.rim_masks));
+    spreads_unmoved_ =
+        spreads_ && (unmoved == UnobservedSpread::On || (unmoved == UnobservedSpread::Auto && !data_.rim_masks));
     // Last, as when the mesh was prepared after the constructor: a bad mask or silhouette is
     // reported before a bad mesh.
     if (preparing_error) std::rethrow_exception(preparing_error);

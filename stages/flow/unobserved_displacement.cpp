@@ -131,7 +131,8 @@ std::vector<std::uint8_t> grow_by_rings(const TriMesh& mesh, std::vector<std::ui
 }  // namespace
 
 std::vector<std::uint8_t> observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
-                                            const VertexFields& fields, const UnobservedDisplacementOptions& options) {
+                                            const VertexFields& fields,
+                                            const UnobservedDisplacementOptions& options) {
   options.check();
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "observed_vertices: fields not sized for the mesh");
   const double cos_observed = std::cos(options.observed_angle_degrees * std::numbers::pi / 180.0);

@@ -82,7 +82,8 @@ struct UnobservedDisplacementOptions {
 //! angle of fields.normal[v]; 0 otherwise.
 //! \throw Error if the options are invalid or the fields are not sized for the mesh.
 std::vector<std::uint8_t> observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
-                                            const VertexFields& fields, const UnobservedDisplacementOptions& options);
+                                            const VertexFields& fields,
+                                            const UnobservedDisplacementOptions& options);
 
 //! One flag per vertex: 1 unless the last iteration gave it a speed (kSpeedDefined) and, with
 //! options.observed_angle_degrees < 90, one of the views in fields.visible(v) lies within that
