@@ -34,6 +34,12 @@ expected_cap, expected_rest = sum(south) / len(south), sum(others) / len(others)
 assert len(south) > 100, len(south)
 assert abs(cap - expected_cap) < 1e-4 and abs(rest - expected_rest) < 1e-4, (cap, rest, expected_cap, expected_rest)
 assert abs(ratio - expected_cap / expected_rest) < 0.01, (ratio, expected_cap / expected_rest)
+# Issue 12's item 5 on the unit spheres, from the line's own figures.
+accuracy = float(re.search(r'acc (\S+)', line).group(1))
+iterations = int(re.search(r'(\d+) it\.', line).group(1))
+met = mean <= 0.0025 and accuracy <= 0.005 and evaluation['completeness'] >= 1 and iterations <= 60
+verdict = re.search(r'item 5 (met|missed: .*)$', line.strip()).group(1)
+assert (verdict == 'met') == met, (verdict, mean, accuracy, evaluation['completeness'], iterations)
 compare = open(f'{work}/compare.txt').read()
 assert "geometric mean 1.000 over 1 scenes" in compare and "identical meshes: 1 of 1" in compare, compare
 # --compare divides the summaries' printed means (5 decimals).
@@ -43,6 +49,15 @@ compare = open(f'{work}/compare_short.txt').read()
 assert ratio != "1.000" and f"{short:.5f}  {ratio}" in compare and "identical meshes: 0 of 1" in compare, compare
 print('quality_scenes.sh agrees with mvflow eval and with the cap computed from the OBJ:', line.strip())
 PY
+# Twelve iterations leave the mean error far above item 5's 0.0025: the verdict names it.
+grep -q "item 5 missed: mean " "$work/runs/short/summary.txt"
+# Groups expand to their scenes; an unknown name is refused before any work.
+if MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" c --scenes "grazing nosuchscene" > "$work/c.txt" 2>&1; then
+  echo "an unknown scene did not make quality_scenes.sh fail" >&2
+  exit 1
+fi
+grep -q "unknown scene 'nosuchscene'.*groups main spheres" "$work/c.txt"
+[ ! -e "$work/runs/c/grazing.ply" ]
 if MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" b --scenes grazing -- --cfl 99 > "$work/b.txt" 2>&1; then
   echo "a failed refinement did not make quality_scenes.sh fail" >&2
   exit 1
