@@ -210,6 +210,10 @@ TEST(UnobservedDisplacement, UnobservedAreTheVerticesWithoutSpeedGrownByTheErode
     const std::vector<std::uint8_t> observed = observed_vertices(mesh, views, fields, options);
     const std::vector<std::uint8_t> poor = poorly_observed_vertices(mesh, views, fields, options);
     for (std::size_t i = 0; i < observed.size(); ++i) EXPECT_EQ(observed[i], 1 - poor[i]) << i << " at " << angle;
+    // Into a reused buffer (the refiner's per-iteration count): stale, longer contents are replaced.
+    std::vector<std::uint8_t> reused(observed.size() + 7, 1);
+    observed_vertices(mesh, views, fields, options, reused);
+    EXPECT_EQ(reused, observed) << angle;
   }
 }
 

@@ -334,13 +334,20 @@ class Refinement {
     if (spreads_) speed_iterations_.assign(mesh_.n_vertices(), 0);
   }
 
+  // The share of this resolution's iterations with a speed up to which a poorly observed vertex
+  // is spread at its convergence: the first resolution's (--hardly-observed-first) before the
+  // first refinement, where the spread is auto without rims; spread_fraction_ otherwise.
+  double hardly_observed_fraction() const {
+    const bool first = mesh_refinements_ == 0 && spread_fraction_ < 1;
+    return first ? options_.unobserved_displacement.first_hardly_observed_fraction : spread_fraction_;
+  }
+
   // One more iteration at this resolution, and which vertices had a speed in it.
   void count_observed() {
     if (!spreads_) return;
     ++level_iterations_;
-    const std::vector<std::uint8_t> observed =
-        observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement);
-    for (std::size_t v = 0; v < speed_iterations_.size(); ++v) speed_iterations_[v] += observed[v];
+    observed_vertices(mesh_, views_, data_.fields, options_.unobserved_displacement, observed_);
+    for (std::size_t v = 0; v < speed_iterations_.size(); ++v) speed_iterations_[v] += observed_[v];
   }
 
   // Removes the folds of the current surface (UntanglingOptions), counted for the summary;
@@ -441,10 +448,7 @@ class Refinement {
     if (options_.refinement_schedule != RefinementSchedule::AtConvergence) return false;
     const auto start = Clock::now();
     const std::vector<Eigen::Vector3d> flowed = spreads_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
-    // The first resolution's fraction applies before the first refinement (auto without rims).
-    const bool first = mesh_refinements_ == 0 && spread_fraction_ < 1;
-    const bool spread =
-        spread_unobserved(first ? options_.unobserved_displacement.first_hardly_observed_fraction : spread_fraction_);
+    const bool spread = spread_unobserved(hardly_observed_fraction());
     const std::optional<UntanglingResult> untangled = untangle_folds();
     if (spread || (untangled && untangled->rounds > 0)) update_curvature();  // the marks follow the moves
     double seconds = seconds_since(start);
@@ -519,6 +523,7 @@ class Refinement {
   //! (1: all; UnobservedDisplacementOptions::hardly_observed_fraction).
   double spread_fraction_ = 1.0;
   std::vector<std::uint32_t> speed_iterations_;  //!< per vertex, iterations at this resolution with a speed
+  std::vector<std::uint8_t> observed_;            //!< count_observed()'s flags of the last iteration, reused
   int level_iterations_ = 0;                      //!< iterations at this resolution
   // Where each vertex was when the flow started (UnobservedDisplacementOptions), midpoints for the
   // vertices refinement added; empty when the option is off.

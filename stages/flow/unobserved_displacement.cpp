@@ -133,10 +133,17 @@ std::vector<std::uint8_t> grow_by_rings(const TriMesh& mesh, std::vector<std::ui
 std::vector<std::uint8_t> observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
                                             const VertexFields& fields,
                                             const UnobservedDisplacementOptions& options) {
+  std::vector<std::uint8_t> observed;
+  observed_vertices(mesh, views, fields, options, observed);
+  return observed;
+}
+
+void observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views, const VertexFields& fields,
+                       const UnobservedDisplacementOptions& options, std::vector<std::uint8_t>& observed) {
   options.check();
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "observed_vertices: fields not sized for the mesh");
   const double cos_observed = std::cos(options.observed_angle_degrees * std::numbers::pi / 180.0);
-  std::vector<std::uint8_t> observed(fields.size(), 0);
+  observed.assign(fields.size(), 0);
   for (std::uint32_t v = 0; v < fields.size(); ++v) {
     if (!(fields.defined[v] & kSpeedDefined)) continue;
     if (options.observed_angle_degrees >= 90.0) {
@@ -152,7 +159,6 @@ std::vector<std::uint8_t> observed_vertices(const TriMesh& mesh, const std::vect
       }
     }
   }
-  return observed;
 }
 
 std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,

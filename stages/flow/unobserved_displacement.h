@@ -84,6 +84,10 @@ struct UnobservedDisplacementOptions {
 std::vector<std::uint8_t> observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
                                             const VertexFields& fields,
                                             const UnobservedDisplacementOptions& options);
+//! The same into \p observed (resized to the vertex count), so that a caller counting every
+//! iteration reuses one buffer.
+void observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views, const VertexFields& fields,
+                       const UnobservedDisplacementOptions& options, std::vector<std::uint8_t>& observed);
 
 //! One flag per vertex: 1 unless the last iteration gave it a speed (kSpeedDefined) and, with
 //! options.observed_angle_degrees < 90, one of the views in fields.visible(v) lies within that
