@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # tools/quality_scenes.sh on issue 12's grazing rig: its line must agree with `mvflow eval`'s JSON
 # and with the south cap's error computed here, independently, from an OBJ copy of the refined
-# mesh; --compare of a run with itself must give 1.000 and identical meshes, with a shorter run its
-# ratio and none; a refinement that fails makes it exit 1.
+# mesh, and its item-5 verdict with the line's own figures; --compare of a run with itself must
+# give 1.000 and identical meshes, with a shorter run its ratio and none; an unknown scene name is
+# refused before any work, and a refinement that fails makes it exit 1.
 #   tests/quality_scenes_check.sh MVFLOW SOURCE_DIR WORK_DIR
 set -euo pipefail
 mvflow=$1 root=$2 work=$3
