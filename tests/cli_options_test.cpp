@@ -59,6 +59,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--max-iterations", {"77", 77}},
       {"--step-tolerance", {"0.004", 0.004}},
       {"--settle-tolerance", {"0.006", 0.006}},
+      {"--settle-noise-reference", {"0.002", 0.002}},
       {"--no-remeshing", {"", false}},
       {"--refine-min-pixels", {"8", 8.0}},
       {"--refine-curvature", {"0.7", 0.7}},
@@ -152,7 +153,7 @@ TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
         {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"},
-        {"--hardly-observed-first", "-0.1"}}) {
+        {"--hardly-observed-first", "-0.1"}, {"--settle-noise-reference", "-0.001"}}) {
     EXPECT_THROW(options_after(bad), CLI::ParseError) << bad[0] << " " << bad[1];
   }
 }

@@ -240,6 +240,10 @@ std::vector<RefineOptionEntry> make_table() {
                     "Stop (settled) when the median net move along the normal over the last 5 iterations is below "
                     "this × the vertex's shortest edge (0 = off, the thesis preset)",
                     [](auto& o) -> auto& { return o.stopping.settled_tolerance; }));
+  t.push_back(value("--settle-noise-reference", "settled_noise_reference", "stopping.settled_noise_reference",
+                    "Photographs noisier than this (σ on [0, 1], estimated from them) raise the settled tolerance by "
+                    "√(σ / this) (0 = off; 0.0013 = what clean 640×480 renders read, README \"Convergence\")",
+                    [](auto& o) -> auto& { return o.stopping.settled_noise_reference; }));
   t.push_back(switch_flag("--no-remeshing", "global_remeshing", "Skip the global split/collapse before the flow",
                           [](auto& o) -> auto& { return o.global_remeshing; }, false));
   t.push_back(value("--refine-min-pixels", "adaptive_min_edge_pixels", "adaptive.min_edge_pixels",

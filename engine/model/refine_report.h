@@ -61,6 +61,8 @@ struct RefineSummary {
   double final_sum_g_per_vertex = 0.0;    //!< at the final positions
   std::size_t self_intersections = 0;     //!< pairs of non-adjacent faces that intersect (final mesh)
   std::size_t untangled_pairs = 0;        //!< crossing face pairs the untangling removed, summed over its calls
+  double image_noise = 0.0;               //!< the photographs' noise σ (estimate_views_noise; 0 when not estimated)
+  double settled_tolerance = 0.0;         //!< the settled rule's tolerance the run used (settled_tolerance_for_noise)
   double seconds = 0.0;
   std::vector<IterationReport> iterations;
 };

@@ -19,6 +19,7 @@
 #include "engine/model/parallel.h"
 #include "stages/topology/adaptive_refinement.h"
 #include "stages/flow/curvature.h"
+#include "stages/flow/image_noise.h"
 #include "stages/flow/image_pyramid.h"
 #include "stages/flow/normals.h"
 #include "stages/flow/photo_consistency.h"
@@ -205,7 +206,14 @@ class Refinement {
     data_.reset_topology();  // the first iteration's Embree scene serves the initial evaluation too
     summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, *data_.surface, options_).sum_g_per_vertex;
 
-    StoppingCriterion stopping(options_.stopping);
+    StoppingOptions stopping_options = options_.stopping;
+    stopping_options.settled_tolerance = settled_tolerance_for_noise(options_.stopping, image_noise_);
+    summary.image_noise = image_noise_;
+    summary.settled_tolerance = stopping_options.settled_tolerance;
+    if (control_.logger && stopping_options.settled_tolerance != options_.stopping.settled_tolerance)
+      control_.logger->info("image noise {:.4f} (median over the views): settled tolerance {:.4f} instead of {:.4f}",
+                            image_noise_, stopping_options.settled_tolerance, options_.stopping.settled_tolerance);
+    StoppingCriterion stopping(stopping_options);
     RefineStatus status = RefineStatus::MaxIterations;
     for (int iteration = 1;; ++iteration) {
       if (cancelled()) {
@@ -315,6 +323,9 @@ class Refinement {
     });
     if (decoding_error) std::rethrow_exception(decoding_error);
     pixel_size_ = finest_pixel_size(full_views_, centre);
+    // The photographs' noise sets the settled rule's tolerance (StoppingOptions::settled_noise_reference).
+    if (options_.stopping.settled_tolerance > 0 && options_.stopping.settled_noise_reference > 0)
+      image_noise_ = estimate_views_noise(full_views_);
     return preparing_error;
   }
 
@@ -517,6 +528,7 @@ class Refinement {
   //! At the run's end the vertices the finest resolution never gave a speed follow too
   //! (UnobservedDisplacementOptions::spread_unmoved).
   bool spreads_unmoved_ = false;
+  double image_noise_ = 0.0;  //!< estimate_views_noise of the photographs (0 when not needed)
   int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the ones with a speed in at most this fraction of the resolution's iterations

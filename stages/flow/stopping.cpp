@@ -36,6 +36,14 @@ void StoppingOptions::check() const {
                  median_move_tolerance, ">= 0 and finite");
   require_option(settled_tolerance >= 0.0 && std::isfinite(settled_tolerance), "settled_tolerance", settled_tolerance,
                  ">= 0 and finite");
+  require_option(settled_noise_reference >= 0.0 && std::isfinite(settled_noise_reference), "settled_noise_reference",
+                 settled_noise_reference, ">= 0 and finite");
+}
+
+double settled_tolerance_for_noise(const StoppingOptions& options, double image_noise) {
+  if (!(options.settled_noise_reference > 0.0) || !(image_noise > options.settled_noise_reference))
+    return options.settled_tolerance;
+  return options.settled_tolerance * std::sqrt(image_noise / options.settled_noise_reference);
 }
 
 StoppingCriterion::StoppingCriterion(StoppingOptions options) : options_(options) {
