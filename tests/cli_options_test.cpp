@@ -59,7 +59,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--max-iterations", {"77", 77}},
       {"--step-tolerance", {"0.004", 0.004}},
       {"--settle-tolerance", {"0.006", 0.006}},
-      {"--settle-noise-reference", {"0.002", 0.002}},
+      {"--settle-noise-reference", {"0.003", 0.003}},
       {"--no-remeshing", {"", false}},
       {"--refine-min-pixels", {"8", 8.0}},
       {"--refine-curvature", {"0.7", 0.7}},

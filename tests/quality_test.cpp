@@ -64,9 +64,11 @@ Distances expect_refinement_halves_the_error(const std::string& name, const std:
   EXPECT_LE(after.accuracy, 0.5 * before.accuracy);
   EXPECT_LT(g_after, g_before);
   EXPECT_EQ(r.at("final").at("self_intersecting_face_pairs").get<int>(), 0);
-  // By default the settled rule's tolerance does not follow the photographs' noise: it is the
-  // option's, and no noise is estimated.
-  EXPECT_EQ(r.at("initial").at("image_noise").get<double>(), 0.0);
+  // Clean renders read below the noise reference even at this size, where their fine texture
+  // reads most (0.0013–0.0018): the settled rule keeps the option's tolerance.
+  const double image_noise = r.at("initial").at("image_noise").get<double>();
+  EXPECT_GT(image_noise, 0.0);
+  EXPECT_LT(image_noise, r.at("options").at("settled_noise_reference").get<double>());
   EXPECT_EQ(r.at("initial").at("settled_tolerance").get<double>(), r.at("options").at("settled_tolerance").get<double>());
   // It ended by a stopping rule, well inside the iteration budget (issue 12: convergence).
   const std::string status = r.at("status").get<std::string>();
@@ -107,11 +109,11 @@ TEST(Quality, Bunny) {
   expect_refinement_halves_the_error("bunny", "--preset bunny" + kSmall);
 }
 
-// Image noise (σ = 0.01 per channel on a two-ring sphere, issue 12's t3 scene): with
-// `--settle-noise-reference 0.0013` the photographs' estimated noise raises the settled tolerance
-// by √(σ̂/0.0013), and the run ends "settled" within 60 iterations (measured 48, mean 0.00170),
-// where by default (the rule off) no level settles and it ends by the Σg rule after more (66,
-// 0.00169): the same error, sooner.
+// Image noise (σ = 0.01 per channel on a two-ring sphere, issue 12's t3 scene): by default the
+// photographs' estimated noise raises the settled tolerance by √(σ̂/0.002), and the run ends
+// "settled" (measured 62 iterations, mean 0.00178), where with the rule off
+// (`--settle-noise-reference 0`) no level settles and it ends by the Σg rule after more (66,
+// 0.00169): about the same error, sooner.
 TEST(Quality, NoisyPhotographsSettleSooner) {
   const test::ScratchFolder dir;
   const auto scene = dir.path() / "scene";
@@ -131,8 +133,8 @@ TEST(Quality, NoisyPhotographsSettleSooner) {
     const Distances after = evaluate(refined, scene / "truth.ply", dir.path() / "eval.json");
     return Run{nlohmann::json::parse(test::read_text(report)), after.mean};
   };
-  const Run noisy = refine(" --settle-noise-reference 0.0013");
-  const Run off = refine("");
+  const Run noisy = refine("");
+  const Run off = refine(" --settle-noise-reference 0");
   const double sigma = noisy.report.at("initial").at("image_noise").get<double>();
   std::printf("[measured] noisy sphere: image noise %.5f, settled tolerance %.5f: mean %.5g, %zu iterations (%s); "
               "rule off: mean %.5g, %zu iterations (%s)\n",
@@ -141,10 +143,10 @@ TEST(Quality, NoisyPhotographsSettleSooner) {
               off.report.at("iterations").size(), off.report.at("status").get<std::string>().c_str());
   // The grey value's noise is σ/√3 = 0.0058 (three independent channels averaged).
   EXPECT_NEAR(sigma, 0.01 / std::sqrt(3.0), 0.0008);
-  EXPECT_NEAR(noisy.report.at("initial").at("settled_tolerance").get<double>(), 0.0025 * std::sqrt(sigma / 0.0013), 1e-12);
+  EXPECT_NEAR(noisy.report.at("initial").at("settled_tolerance").get<double>(), 0.0025 * std::sqrt(sigma / 0.002), 1e-12);
   EXPECT_EQ(off.report.at("initial").at("settled_tolerance").get<double>(), 0.0025);
+  EXPECT_EQ(off.report.at("initial").at("image_noise").get<double>(), 0.0);  // not estimated when off
   EXPECT_EQ(noisy.report.at("status").get<std::string>(), "settled");
-  EXPECT_LE(noisy.report.at("iterations").size(), 60u);
   EXPECT_LT(noisy.report.at("iterations").size(), off.report.at("iterations").size());
   EXPECT_LE(noisy.mean, 0.0025);
   EXPECT_LE(noisy.mean, 1.1 * off.mean);

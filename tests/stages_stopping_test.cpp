@@ -39,6 +39,7 @@ TEST(StoppingOptions, DefaultsFollowTheThesisButForTheTestTheBudgetAndTheMoveRul
   EXPECT_EQ(o.test, ConvergenceTest::NoImprovement);
   EXPECT_EQ(o.epsilon_percent, 0.3);
   EXPECT_EQ(o.settled_tolerance, 0.0025);
+  EXPECT_EQ(o.settled_noise_reference, 0.002);
   EXPECT_EQ(o.min_iterations, 10);
   EXPECT_EQ(o.max_iterations, 200);
   EXPECT_EQ(o.lookback, 5);

@@ -242,7 +242,7 @@ std::vector<RefineOptionEntry> make_table() {
                     [](auto& o) -> auto& { return o.stopping.settled_tolerance; }));
   t.push_back(value("--settle-noise-reference", "settled_noise_reference", "stopping.settled_noise_reference",
                     "Photographs noisier than this (σ on [0, 1], estimated from them) raise the settled tolerance by "
-                    "√(σ / this) (0 = off; 0.0013 = what clean 640×480 renders read, README \"Convergence\")",
+                    "√(σ / this) (0 = off; clean renders and photographs here read 0.0006–0.0018, README \"Convergence\")",
                     [](auto& o) -> auto& { return o.stopping.settled_noise_reference; }));
   t.push_back(switch_flag("--no-remeshing", "global_remeshing", "Skip the global split/collapse before the flow",
                           [](auto& o) -> auto& { return o.global_remeshing; }, false));

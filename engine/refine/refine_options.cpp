@@ -43,6 +43,7 @@ RefineOptions thesis_preset() {
   options.stopping.max_iterations = 100;
   options.stopping.median_move_tolerance = 0.002;
   options.stopping.settled_tolerance = 0.0;
+  options.stopping.settled_noise_reference = 0.0;
   options.damping.enabled = false;
   options.speed_quantile = 1.0;
   options.local_step = false;
