@@ -189,6 +189,8 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   EXPECT_LT(quarter, moved(automatic.output));
   EXPECT_LT(moved(automatic.output), all);
   EXPECT_EQ(all, moved(on.output));
+  // The first resolution keeps its own fraction whatever the later one, 1 (all) included.
+  EXPECT_EQ(first_moved("0.25 --hardly-observed 1"), quarter);
 }
 
 // `refine --masks`: silhouettes from files instead of thresholded photographs, so a textured

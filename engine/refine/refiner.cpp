@@ -177,9 +177,8 @@ class Refinement {
       data_.rim_masks = &rim_masks_;
       data_.rim_views = &full_views_;
     }
-    spread_fraction_ = options.unobserved_displacement.spread == UnobservedSpread::Auto && !data_.rim_masks
-                           ? options.unobserved_displacement.hardly_observed_fraction
-                           : 1.0;
+    spreads_hardly_observed_ = options.unobserved_displacement.spread == UnobservedSpread::Auto && !data_.rim_masks;
+    spread_fraction_ = spreads_hardly_observed_ ? options.unobserved_displacement.hardly_observed_fraction : 1.0;
     const UnobservedSpread unmoved = options.unobserved_displacement.spread_unmoved;
     spreads_unmoved_ =
         spreads_ && (unmoved == UnobservedSpread::On || (unmoved == UnobservedSpread::Auto && !data_.rim_masks));
@@ -201,7 +200,7 @@ class Refinement {
                             options_.rims.fit == RimFit::Auto ? ": every view's border is dark" : "");
     if (control_.logger && spreads_)
       control_.logger->info("{} follow the observed surface{}",
-                            spread_fraction_ < 1 ? "hardly observed vertices" : "unobserved vertices",
+                            spreads_hardly_observed_ ? "hardly observed vertices" : "unobserved vertices",
                             data_.rim_masks ? " and the silhouette rims" : "");
     data_.reset_topology();  // the first iteration's Embree scene serves the initial evaluation too
     summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, *data_.surface, options_).sum_g_per_vertex;
@@ -349,7 +348,7 @@ class Refinement {
   // is spread at its convergence: the first resolution's (--hardly-observed-first) before the
   // first refinement, where the spread is auto without rims; spread_fraction_ otherwise.
   double hardly_observed_fraction() const {
-    const bool first = mesh_refinements_ == 0 && spread_fraction_ < 1;
+    const bool first = mesh_refinements_ == 0 && spreads_hardly_observed_;
     return first ? options_.unobserved_displacement.first_hardly_observed_fraction : spread_fraction_;
   }
 
@@ -534,6 +533,9 @@ class Refinement {
   //! Of those, only the ones with a speed in at most this fraction of the resolution's iterations
   //! (1: all; UnobservedDisplacementOptions::hardly_observed_fraction).
   double spread_fraction_ = 1.0;
+  //! The spread is auto without rims: the hardly observed follow, by the first resolution's own
+  //! fraction before the first refinement (whatever the later fraction, 1 included).
+  bool spreads_hardly_observed_ = false;
   std::vector<std::uint32_t> speed_iterations_;  //!< per vertex, iterations at this resolution with a speed
   std::vector<std::uint8_t> observed_;            //!< count_observed()'s flags of the last iteration, reused
   int level_iterations_ = 0;                      //!< iterations at this resolution
