@@ -37,8 +37,8 @@ Image ramp(double sigma, unsigned seed = 1) {
 TEST(ImageNoise, APlaneHasNoneAndGaussianNoiseIsRecovered) {
   // The mask cancels any planar intensity: only the float rounding of the values is left.
   EXPECT_LT(estimate_image_noise(ramp(0.0)), 1e-6);
-  // E|Σ M·n| = σ·‖M‖·√(2/π) with ‖M‖ = 6: the estimate is σ on average (some 300 000 responses,
-  // neighbours correlated: within 3 %).
+  // E|Σ M·n| = σ·‖M‖·√(2/π) with ‖M‖ = 6: the estimate is σ on average (the flattest tenth: some
+  // 30 000 responses, chosen by a gradient independent of them on noise; within 3 %).
   for (const double sigma : {0.002, 0.01, 0.03}) {
     const double estimate = estimate_image_noise(ramp(sigma, static_cast<unsigned>(1000 * sigma)));
     EXPECT_NEAR(estimate / sigma, 1.0, 0.03) << sigma;

@@ -11,7 +11,7 @@
 namespace mvflow {
 namespace {
 
-// Whether the 3×3 pixels around *centre (rows \p stride apart) are all equal: clipped to black
+// Whether the 3×3 pixels around above[stride] (rows \p stride apart) are all equal: clipped to black
 // or white, or a synthetic fill. Noise never leaves that, so such pixels say nothing about it; a
 // photograph's black background would otherwise be its flattest tenth and read σ = 0.
 bool constant_around(const float* above, int stride) {
