@@ -10,6 +10,8 @@ mvflow=$1 root=$2 work=$3
 rm -rf "$work"
 mkdir -p "$work"
 MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" a --scenes grazing > "$work/a.txt"
+# The same run with 30° bands (the same mesh: a run is deterministic).
+MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" d --scenes grazing --band-degrees 30 > "$work/d.txt"
 MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" --compare a a > "$work/compare.txt"
 # A run that differs (stopped after 12 iterations): its ratio is not 1 and its mesh not identical.
 MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" short --scenes grazing -- --max-iterations 12 > /dev/null
@@ -35,6 +37,19 @@ expected_cap, expected_rest = sum(south) / len(south), sum(others) / len(others)
 assert len(south) > 100, len(south)
 assert abs(cap - expected_cap) < 1e-4 and abs(rest - expected_rest) < 1e-4, (cap, rest, expected_cap, expected_rest)
 assert abs(ratio - expected_cap / expected_rest) < 0.01, (ratio, expected_cap / expected_rest)
+# The signed bands, per 20° and per 30°, against the same vertices; the image noise as reported.
+positions = [[float(c) for c in text.split()[1:4]] for text in open(f'{work}/grazing.obj') if text.startswith('v ')]
+for text, degrees in ((line, 20), (open(f'{work}/d.txt').read(), 30)):
+    printed = [float(x) for x in re.search(rf'signed per {degrees}° from the south ((?:\S+ ?)+?) \|', text).group(1).split()]
+    bands = [[] for _ in range(180 // degrees)]
+    for x, y, z in positions:
+        r = math.sqrt(x * x + y * y + z * z)
+        bands[min(len(bands) - 1, int((math.degrees(math.asin(y / r)) + 90) // degrees))].append(r - 1)
+    expected = [sum(b) / len(b) for b in bands]
+    assert len(printed) == len(expected) and all(abs(p - q) < 6e-5 for p, q in zip(printed, expected)), (degrees, printed, expected)
+report = json.load(open(f'{work}/runs/a/grazing.json'))
+noise = float(re.search(r'image noise (\S+?)(?: \||$)', line.strip()).group(1))
+assert abs(noise - report['initial']['image_noise']) < 6e-6, (noise, report['initial']['image_noise'])
 # Issue 12's item 5 on the unit spheres, from the line's own figures.
 accuracy = float(re.search(r'acc (\S+)', line).group(1))
 iterations = int(re.search(r'(\d+) it\.', line).group(1))
@@ -59,6 +74,11 @@ if MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" c --scenes "grazi
 fi
 grep -q "unknown scene 'nosuchscene'.*groups main spheres" "$work/c.txt"
 [ ! -e "$work/runs/c/grazing.ply" ]
+if MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" e --scenes grazing --band-degrees 7 > "$work/e.txt" 2>&1; then
+  echo "--band-degrees 7 (not dividing 180) was not refused" >&2
+  exit 1
+fi
+grep -q "band-degrees must be a whole number dividing 180, got '7'" "$work/e.txt"
 if MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" b --scenes grazing -- --cfl 99 > "$work/b.txt" 2>&1; then
   echo "a failed refinement did not make quality_scenes.sh fail" >&2
   exit 1

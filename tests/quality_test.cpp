@@ -55,11 +55,12 @@ Distances expect_refinement_halves_the_error(const std::string& name, const std:
   const double g_before = r.at("initial").at("sum_g_per_vertex").get<double>();
   const double g_after = r.at("final").at("sum_g_per_vertex").get<double>();
   std::printf("[measured] %s: mean %.4g -> %.4g (%.0f %%), accuracy %.4g -> %.4g (%.0f %%), Σg/vertex %.4g -> %.4g, "
-              "%d -> %d vertices, %zu iterations (%s)\n",
+              "%d -> %d vertices, %zu iterations (%s), image noise %.5f\n",
               name.c_str(), before.mean, after.mean, 100.0 * (after.mean / before.mean - 1.0), before.accuracy,
               after.accuracy, 100.0 * (after.accuracy / before.accuracy - 1.0), g_before, g_after,
               r.at("initial").at("vertices").get<int>(), r.at("final").at("vertices").get<int>(),
-              r.at("iterations").size(), r.at("status").get<std::string>().c_str());
+              r.at("iterations").size(), r.at("status").get<std::string>().c_str(),
+              r.at("initial").at("image_noise").get<double>());
   EXPECT_LE(after.mean, 0.5 * before.mean);
   EXPECT_LE(after.accuracy, 0.5 * before.accuracy);
   EXPECT_LT(g_after, g_before);

@@ -178,7 +178,6 @@ class Refinement {
       data_.rim_views = &full_views_;
     }
     spreads_hardly_observed_ = options.unobserved_displacement.spread == UnobservedSpread::Auto && !data_.rim_masks;
-    spread_fraction_ = spreads_hardly_observed_ ? options.unobserved_displacement.hardly_observed_fraction : 1.0;
     const UnobservedSpread unmoved = options.unobserved_displacement.spread_unmoved;
     spreads_unmoved_ =
         spreads_ && (unmoved == UnobservedSpread::On || (unmoved == UnobservedSpread::Auto && !data_.rim_masks));
@@ -267,7 +266,7 @@ class Refinement {
     // At convergence the spread runs before each refinement (refine_at_convergence); refined every
     // iteration, once here.
     if (status != RefineStatus::Cancelled && options_.refinement_schedule == RefinementSchedule::EveryIteration)
-      spread_unobserved(spread_fraction_);
+      spread_unobserved(spread_fraction());
     else if (status != RefineStatus::Cancelled && spreads_unmoved_)
       spread_unobserved(0.0);
     const std::optional<UntanglingResult> untangled =
@@ -344,12 +343,17 @@ class Refinement {
     if (spreads_) speed_iterations_.assign(mesh_.n_vertices(), 0);
   }
 
-  // The share of this resolution's iterations with a speed up to which a poorly observed vertex
-  // is spread at its convergence: the first resolution's (--hardly-observed-first) before the
-  // first refinement, where the spread is auto without rims; spread_fraction_ otherwise.
+  // The share of a resolution's iterations with a speed up to which a poorly observed vertex
+  // is spread (1: every unobserved vertex; UnobservedDisplacementOptions::hardly_observed_fraction).
+  double spread_fraction() const {
+    return spreads_hardly_observed_ ? options_.unobserved_displacement.hardly_observed_fraction : 1.0;
+  }
+
+  // spread_fraction() at this resolution's convergence: the first resolution's own
+  // (--hardly-observed-first) before the first refinement where the spread is auto without rims.
   double hardly_observed_fraction() const {
     const bool first = mesh_refinements_ == 0 && spreads_hardly_observed_;
-    return first ? options_.unobserved_displacement.first_hardly_observed_fraction : spread_fraction_;
+    return first ? options_.unobserved_displacement.first_hardly_observed_fraction : spread_fraction();
   }
 
   // One more iteration at this resolution, and which vertices had a speed in it.
@@ -530,11 +534,7 @@ class Refinement {
   double image_noise_ = 0.0;  //!< estimate_views_noise of the photographs (0 when not needed)
   int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
-  //! Of those, only the ones with a speed in at most this fraction of the resolution's iterations
-  //! (1: all; UnobservedDisplacementOptions::hardly_observed_fraction).
-  double spread_fraction_ = 1.0;
-  //! The spread is auto without rims: the hardly observed follow, by the first resolution's own
-  //! fraction before the first refinement (whatever the later fraction, 1 included).
+  //! Of those, only the hardly observed (the spread is auto without rims: spread_fraction()).
   bool spreads_hardly_observed_ = false;
   std::vector<std::uint32_t> speed_iterations_;  //!< per vertex, iterations at this resolution with a speed
   std::vector<std::uint8_t> observed_;            //!< count_observed()'s flags of the last iteration, reused
