@@ -131,6 +131,12 @@ int run(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-refine", [&](std::int64_t) { settings.whole_refinement = false; },
                "Skip the whole refinement (fixed-topology iterations only)");
+  std::string surface_patch = "oblique";
+  app.add_option("--surface-patch", surface_patch,
+                 "Grid suite: patches on the surface at oblique vertices (the default), everywhere (on) or nowhere "
+                 "(off), as refine --surface-patch")
+      ->check(CLI::IsMember({"off", "oblique", "on"}))
+      ->capture_default_str();
   app.add_option("--supersample", supersample, "Rays per pixel N×N when rendering the grid scenes")
       ->check(CLI::Range(1, 8))
       ->capture_default_str();
@@ -140,6 +146,9 @@ int run(int argc, char** argv) {
   app.add_flag("--no-validate", no_validate, "Do not check that every configuration gives the same mesh (nor that "
                                              "the suites' refinements lower Σg or the error)");
   CLI11_PARSE(app, argc, argv);
+  settings.surface_patch = surface_patch == "on"    ? SurfacePatchUse::On
+                          : surface_patch == "off" ? SurfacePatchUse::Off
+                                                   : SurfacePatchUse::Oblique;
   if (quick && sizes.empty()) sizes = {"1k/8/640x480", "10k/16/640x480"};
   if (sizes.empty()) sizes = full_grid();
   // Before the runs, which take minutes to hours: an unwritable output is known at once.
@@ -155,6 +164,7 @@ int run(int argc, char** argv) {
   }();
   document["machine"] = machine_description();
   document["photo_kernel"] = photo_kernel_summary();  // MVFLOW_KERNEL=baseline|avx2|avx512 forces one
+  document["surface_patch"] = surface_patch;
   document["peak_memory_reset"] = reset_peak_memory();
   std::map<std::string, std::vector<Row>> tables;
   for (const std::string& suite : suites) {

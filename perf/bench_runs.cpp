@@ -59,7 +59,9 @@ Measurement measure(const BenchScene& scene, const RunConfig& config, const RunS
   release_free_memory();
   m.peak_reset = reset_peak_memory();
 
-  const RefineResult fixed = refine_or_throw(scene, fixed_topology_options(settings.timed_iterations), config);
+  RefineOptions fixed_options = fixed_topology_options(settings.timed_iterations);
+  fixed_options.photo.photo.surface_patch = settings.surface_patch;
+  const RefineResult fixed = refine_or_throw(scene, fixed_options, config);
   const auto& iterations = fixed.summary.iterations;
   const double timed = static_cast<double>(iterations.size() - 1);
   for (std::size_t i = 1; i < iterations.size(); ++i) {
@@ -74,6 +76,7 @@ Measurement measure(const BenchScene& scene, const RunConfig& config, const RunS
     RefineOptions options;
     options.stopping.max_iterations = settings.refine_iterations;
     options.stopping.min_iterations = std::min(options.stopping.min_iterations, settings.refine_iterations);
+    options.photo.photo.surface_patch = settings.surface_patch;
     const RefineResult whole = refine_or_throw(scene, options, config);
     m.refine_seconds = whole.summary.seconds;
     m.refine_iterations = static_cast<int>(whole.summary.iterations.size());

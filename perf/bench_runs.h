@@ -22,6 +22,9 @@ struct RunSettings {
   //! Cap on the iterations of the whole refinement (≥ 6).
   int refine_iterations = 10;
   bool whole_refinement = true;  //!< false: only the fixed-topology refinement
+  //! Where g lays its patches on the surface (the default's Oblique; Off for the thesis's image
+  //! patches alone, to compare in one run).
+  SurfacePatchUse surface_patch = PhotoConsistencyOptions{}.surface_patch;
 };
 
 struct RunConfig {

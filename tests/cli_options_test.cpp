@@ -32,7 +32,8 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--min-views", {"4", 4}},
       {"--image-levels", {"2", 2}},
       {"--normalize", {"on", true}},
-      {"--surface-patch", {"on", true}},
+      {"--surface-patch", {"on", "on"}},
+      {"--surface-patch-angle", {"50", 50.0}},
       {"--surface-patch-spacing", {"3", 3.0}},
       {"--noise-floor", {"0.05", 0.05}},
       {"--drop-views", {"2", 2}},
@@ -105,7 +106,7 @@ TEST(RefinePresets, AccurateIsTheDefaultWithSurfacePatchesAndTheFinerSettledTole
   for (const auto& [key, value] : plain.items())
     if (accurate.at(key) != value) differing.insert(key);
   EXPECT_EQ(differing, (std::set<std::string>{"preset", "photo_surface_patch", "settled_tolerance"}));
-  EXPECT_EQ(accurate.at("photo_surface_patch"), true);
+  EXPECT_EQ(accurate.at("photo_surface_patch"), "on");
   EXPECT_EQ(accurate.at("settled_tolerance"), 0.001);
   preset("accurate").check();
   EXPECT_THROW(preset("fast"), InputError);

@@ -121,10 +121,15 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   const auto synth = test::run_mvflow("synth --amplitude 0 --views 12 --width 320 --height 240 --level 4 "
                                       "--init offset:0.02 --init-vertices 642 --elevation -15,25 -o " + scene.string());
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  const auto automatic = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "auto.ply").string());
-  const auto on = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "on.ply").string() +
+  // With the thesis's image patches: with the default's surface patches at oblique vertices a
+  // crumpled band at −45…−23° of this 12-view 320×240 rig never gets a speed at the finest
+  // resolution (one view left each; README, "Surface patches"), and the spread at the end takes
+  // it too.
+  const std::string refine = "refine " + scene.string() + " --surface-patch off";
+  const auto automatic = test::run_mvflow(refine + " -o " + (folder / "auto.ply").string());
+  const auto on = test::run_mvflow(refine + " -o " + (folder / "on.ply").string() +
                                    " --spread-unobserved on");
-  const auto off = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "off.ply").string() +
+  const auto off = test::run_mvflow(refine + " -o " + (folder / "off.ply").string() +
                                     " --spread-unobserved off");
   ASSERT_EQ(automatic.exit_code, 0) << automatic.output;
   ASSERT_EQ(on.exit_code, 0) << on.output;
@@ -149,7 +154,7 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   // ids match; measured: 388 vertices moved, none within ±45°). Whether that brings a cap nearer
   // depends on the scene: on the fifteen of the README 0.988× the error, here this rig's cap
   // below −75° 0.0091 → 0.0105 (README, "Weakly seen regions").
-  const auto unmoved_off = test::run_mvflow("refine " + scene.string() + " -o " +
+  const auto unmoved_off = test::run_mvflow(refine + " -o " +
                                             (folder / "unmoved_off.ply").string() + " --spread-unmoved off");
   ASSERT_EQ(unmoved_off.exit_code, 0) << unmoved_off.output;
   const auto spreads = [](const std::string& output) {
@@ -180,7 +185,7 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   // iterations (--hardly-observed-first), a superset of those in at most 1/4 and a subset of
   // all of them (`on`: the same set as a fraction of 1). Measured: 159, 247 and 432 vertices.
   const auto first_moved = [&](const std::string& fraction) {
-    const auto r = test::run_mvflow("refine " + scene.string() + " -o " + (folder / "first.ply").string() +
+    const auto r = test::run_mvflow(refine + " -o " + (folder / "first.ply").string() +
                                     " --hardly-observed-first " + fraction);
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return moved(r.output);

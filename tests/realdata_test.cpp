@@ -105,9 +105,11 @@ void expect_reference_accuracy_on_photographs(const std::string& set) {
     for (const std::uint32_t v : t) normals[v] += n;
     shortest_edge = std::min({shortest_edge, (b - a).norm(), (c - b).norm(), (a - c).norm()});
   }
-  const PhotoGradientStage stage;
+  PhotoGradientOptions image_options;  // the double-precision reference reads image patches
+  image_options.photo.surface_patch = SurfacePatchUse::Off;
+  const PhotoGradientStage stage(image_options);
   PhotoGradientOptions surface_options;
-  surface_options.photo.surface_patch = true;
+  surface_options.photo.surface_patch = SurfacePatchUse::On;
   const PhotoGradientStage surface_stage(surface_options);
   const double dx = stage.sample_spacing(shortest_edge);
   double worst_g = 0, worst_gradient = 0, smallest_g = 1e300;

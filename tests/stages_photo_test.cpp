@@ -419,7 +419,9 @@ TEST(PhotoGradient, ExactOnALinearField) {
   // g itself is not linear in X, but the Savitzky–Golay sum is: check the stage's arithmetic by
   // comparing with the same sum written out here.
   const PlaneScene scene = tilted_plane_scene();
-  const PhotoGradientStage stage;
+  PhotoGradientOptions whole_pixel;  // written out below with image patches
+  whole_pixel.photo.surface_patch = SurfacePatchUse::Off;
+  const PhotoGradientStage stage(whole_pixel);
   const Eigen::Vector3d X(1.3, -2.1, 0.7);
   const double dx = 0.05;
   Mesh mesh;
@@ -619,7 +621,9 @@ TEST(PhotoGradient, MatchesTheSlowReferenceOnARenderedObject) {
   // ∇g of the stage (float interpolation, samples projected linearly in s) against the same
   // Savitzky–Golay sum over the double-precision reference at each sample point.
   const SphereScene& s = sphere_scene();
-  const PhotoGradientStage stage;
+  PhotoGradientOptions whole_pixel;  // the reference reads image patches
+  whole_pixel.photo.surface_patch = SurfacePatchUse::Off;
+  const PhotoGradientStage stage(whole_pixel);
   const double dx = stage.sample_spacing(s.shortest_edge);
   Mesh probes;
   std::vector<std::uint32_t> source;
@@ -1010,7 +1014,7 @@ TEST(SurfacePatch, ReadsTheImagesLastPixelWithoutPassingIt) {
 
 TEST(SurfacePatch, TheGradientStagePointsAwayFromThePlane) {
   PhotoGradientOptions options;
-  options.photo.surface_patch = true;
+  options.photo.surface_patch = SurfacePatchUse::On;
   const PhotoGradientStage stage(options);
   const PlaneScene scene = oblique_plane_scene();
   const double edge = 4.0;
@@ -1049,15 +1053,92 @@ TEST(SurfacePatch, TheGradientStagePointsAwayFromThePlane) {
 
 TEST(SurfacePatch, OptionsOutOfRangeAreRefused) {
   PhotoConsistencyOptions options;
-  options.surface_patch = true;
+  EXPECT_EQ(options.surface_patch, SurfacePatchUse::Oblique);
+  EXPECT_EQ(options.surface_patch_angle_degrees, 60.0);
+  options.surface_patch = SurfacePatchUse::On;
   EXPECT_NO_THROW(options.check());
   options.normalize = true;
   EXPECT_THROW(options.check(), OptionError);
+  options.surface_patch = SurfacePatchUse::Oblique;  // normalized patches stay image patches
+  EXPECT_NO_THROW(options.check());
   options.normalize = false;
   for (const double spacing : {0.0, -1.0, 8.5, std::nan("")}) {
     options.surface_patch_spacing = spacing;
     EXPECT_THROW(options.check(), OptionError) << spacing;
   }
+  options.surface_patch_spacing = 1.5;
+  for (const double angle : {0.0, -10.0, 90.5, std::nan("")}) {
+    options.surface_patch_angle_degrees = angle;
+    EXPECT_THROW(options.check(), OptionError) << angle;
+  }
+}
+
+// SurfacePatchUse::Oblique: a vertex lays its patch on the surface exactly when one of its views is
+// farther than the angle from its normal, and then g and ∇g are those of surface patches
+// everywhere (On), else those of image patches (Off), bit for bit.
+TEST(SurfacePatch, ObliqueVerticesAloneUseSurfacePatches) {
+  const PlaneScene scene = oblique_plane_scene();  // views at 0°, 35°, 60° and 65° from the normal
+  const Eigen::Vector3d X(1.3, -0.7, 0), N = Eigen::Vector3d::UnitZ();
+  PhotoConsistencyOptions oblique;
+  const auto uses = [&](std::vector<std::uint16_t> ids, double angle) {
+    oblique.surface_patch_angle_degrees = angle;
+    return uses_surface_patch(X, N, ids, scene.views, oblique);
+  };
+  EXPECT_FALSE(uses({0, 1}, 60));
+  EXPECT_FALSE(uses({0, 1, 2}, 60.5));  // 60° is not beyond 60.5°
+  EXPECT_TRUE(uses({0, 1, 2}, 59.5));
+  EXPECT_TRUE(uses({0, 3}, 60));
+  EXPECT_FALSE(uses({0, 3}, 66));
+  EXPECT_TRUE(uses({1}, 30));
+  EXPECT_FALSE(uses({}, 1));
+  oblique.surface_patch_angle_degrees = 60;
+  EXPECT_FALSE(uses_surface_patch(X, Eigen::Vector3d::Zero(), scene.all, scene.views, oblique));  // no normal
+  oblique.normalize = true;
+  EXPECT_FALSE(uses_surface_patch(X, N, scene.all, scene.views, oblique));
+  oblique.normalize = false;
+  PhotoConsistencyOptions on = oblique, off = oblique;
+  on.surface_patch = SurfacePatchUse::On;
+  off.surface_patch = SurfacePatchUse::Off;
+  EXPECT_TRUE(uses_surface_patch(X, N, std::vector<std::uint16_t>{0, 1}, scene.views, on));
+  EXPECT_FALSE(uses_surface_patch(X, N, scene.all, scene.views, off));
+
+  // The gradient stage over a few points above and below the plane, seen by views 0–1 (frontal
+  // enough: image patches) or by views 0–3 (the 65° view: surface patches).
+  Mesh mesh;
+  for (double x = -6; x <= 6; x += 3)
+    for (const double z : {-1.5, 0.0, 2.0}) mesh.topology.add_vertex(to_openmesh(Eigen::Vector3d(x, 0.4 * x, z)));
+  const auto run = [&](const PhotoConsistencyOptions& photo) {
+    VertexFields fields;
+    fields.resize(mesh.n_vertices(), scene.views.size());
+    for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+      fields.normal[v] = N;
+      fields.visible_count[v] = v % 2 ? 4 : 2;
+      std::copy(scene.all.begin(), scene.all.end(), fields.visible_views.begin() + v * fields.view_capacity);
+    }
+    PhotoGradientOptions options;
+    options.photo = photo;
+    const PhotoGradientStage stage(options);
+    stage.run(mesh.topology, {0, static_cast<std::uint32_t>(mesh.n_vertices())}, scene.views, stage.sample_spacing(4.0),
+              fields);
+    return fields;
+  };
+  const VertexFields mixed = run(oblique), surface = run(on), image = run(off);
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+    const VertexFields& expected = v % 2 ? surface : image;
+    ASSERT_TRUE(mixed.defined[v] & kGradientDefined) << v;
+    EXPECT_EQ(mixed.photo_consistency[v], expected.photo_consistency[v]) << v;
+    EXPECT_EQ(mixed.photo_gradient[v], expected.photo_gradient[v]) << v;
+    // The two kinds of patch differ here, so the comparison tells them apart.
+    EXPECT_NE(surface.photo_consistency[v], image.photo_consistency[v]) << v;
+  }
+  // g alone at the surface follows the same rule.
+  SurfacePatchLayout layout;
+  layout_surface_patch(X, N, scene.all, scene.views, 2, oblique.surface_patch_spacing, layout);
+  EXPECT_EQ(photo_consistency_at_surface(X, N, scene.all, scene.views, oblique, layout).g,
+            surface_patch_consistency(X, layout, scene.views).g);
+  const std::vector<std::uint16_t> frontal{0, 1};
+  EXPECT_EQ(photo_consistency_at_surface(X, N, frontal, scene.views, oblique, layout).g,
+            photo_consistency(X, frontal, scene.views).g);
 }
 
 }  // namespace

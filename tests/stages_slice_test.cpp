@@ -42,7 +42,7 @@ TEST(PlaneCrossSection, IsACircleOnASphere) {
 
 // Median g on the true surface and 0.1–0.2 radii outside it, on a horizontal slice of a rendered
 // bumpy sphere, with the thesis's image patches or with surface patches.
-std::pair<double, double> valley_of_g(bool surface_patch) {
+std::pair<double, double> valley_of_g(SurfacePatchUse surface_patch) {
   SynthOptions options;
   options.rig.views = 8;
   options.rig.width = 200;
@@ -87,14 +87,14 @@ std::pair<double, double> valley_of_g(bool surface_patch) {
 }
 
 TEST(PhotoSlice, ValleyOfGAlongTheTrueSurface) {
-  const auto [on, off] = valley_of_g(false);
+  const auto [on, off] = valley_of_g(SurfacePatchUse::Off);
   std::printf("[measured] median g on the surface %.4g, 0.1–0.2 radii outside %.4g (ratio %.3g)\n", on, off, on / off);
   EXPECT_LT(on, 0.5 * off);
 }
 
 TEST(PhotoSlice, ValleyOfGAlongTheTrueSurfaceWithSurfacePatches) {
   // Each point's patch lies on the tangent plane of the nearest vertex of the true mesh.
-  const auto [on, off] = valley_of_g(true);
+  const auto [on, off] = valley_of_g(SurfacePatchUse::On);
   std::printf("[measured] surface patches: median g on the surface %.4g, 0.1–0.2 radii outside %.4g (ratio %.3g)\n",
               on, off, on / off);
   EXPECT_GT(off, 0.0);

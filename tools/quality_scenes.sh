@@ -12,7 +12,9 @@
 # (session 22): u1–u8, unit spheres on other rigs, seeds and noise levels; b1–b3, the bumpy
 # sphere on other rigs; w1–w6, the six scenes of "Weakly seen regions". --scenes takes names or
 # the groups main (the fifteen), spheres (grazing peer t3 v5 u1–u8), bumpy-family (bumpy b1–b3), weak
-# (w1–w6), held-out (u1–u8 b1–b3 w1–w6) and all. The scenes go to OUT/scenes/NAME (rendered only when missing, so
+# (w1–w6), held-out (u1–u8 b1–b3 w1–w6) and all (those 32). Session 24 added l1–l8, the group low: spheres
+# and bumpy spheres on small rigs (320×240 but l7, 12 views but l5), held out from every choice
+# and not in all, so that all stays the 32 of earlier runs. The scenes go to OUT/scenes/NAME (rendered only when missing, so
 # every TAG is scored on the same photographs), the runs to OUT/runs/TAG/NAME.{ply,json,eval.json},
 # one line per scene to OUT/runs/TAG/summary.txt and stdout. On the unit spheres "cap" is the mean
 # radial error of the vertices beyond 55° latitude on the side the rig sees worst (south for
@@ -87,6 +89,7 @@ expand_groups() {  # the scene names of $1, its groups expanded
       bumpy-family) expanded+=" bumpy b1 b2 b3" ;;
       weak) expanded+=" w1 w2 w3 w4 w5 w6" ;;
       held-out) expanded+=" $held_out" ;;
+      low) expanded+=" l1 l2 l3 l4 l5 l6 l7 l8" ;;
       all) expanded+=" $main $held_out" ;;
       *) expanded+=" $name" ;;
     esac
@@ -109,6 +112,7 @@ refine_options=("$@")
 [ -x "$mvflow" ] || { echo "$0: $mvflow is missing: build first (bash tools/build.sh)" >&2; exit 1; }
 
 rig=(--amplitude 0 --views 24 --width 640 --height 480 --level 6 --init offset:0.011547 --init-vertices 2562)
+low=(--views 12 --width 320 --height 240)
 synth_options() {  # sets the array synth_args for scene $1; 1 if unknown
   case $1 in
     bumpy) synth_args=(--preset default) ;;
@@ -143,11 +147,19 @@ synth_options() {  # sets the array synth_args for scene $1; 1 if unknown
     w4) synth_args=(--preset peanut --elevation "-30,15" --views 24 --seed 34) ;;
     w5) synth_args=(--amplitude 0.06 --frequency 5 --elevation "-25,30" --views 20 --seed 35) ;;
     w6) synth_args=(--preset spot --elevation "-20,40" --seed 36) ;;
+    l1) synth_args=("${low[@]}" --amplitude 0 --level 4 --init offset:0.02 --init-vertices 642 --elevation "-15,25") ;;
+    l2) synth_args=("${low[@]}" --amplitude 0 --level 4 --init offset:0.02 --init-vertices 642 --elevation "-25,15" --seed 3) ;;
+    l3) synth_args=("${low[@]}" --amplitude 0.05 --level 4 --init offset:0.02 --init-vertices 642 --elevation "-10,30" --seed 4) ;;
+    l4) synth_args=("${low[@]}" --amplitude 0 --init-vertices 800 --elevation "-15,25" --seed 5) ;;
+    l5) synth_args=(--width 320 --height 240 --views 16 --amplitude 0 --elevation "-20,20" --seed 6) ;;
+    l6) synth_args=("${low[@]}" --elevation "0,30" --seed 7) ;;
+    l7) synth_args=(--amplitude 0 --views 12 --elevation "-15,25" --seed 8) ;;
+    l8) synth_args=("${low[@]}" --amplitude 0 --elevation "-15,25" --seed 9 --noise 0.005) ;;
     *) return 1 ;;
   esac
 }
 for name in $scenes; do
-  synth_options "$name" || { echo "$0: unknown scene '$name' (known: bumpy peanut bunny grazing peer t1-t5 v1-v5 u1-u8 b1-b3 w1-w6, groups main spheres bumpy-family weak held-out all)" >&2; exit 2; }
+  synth_options "$name" || { echo "$0: unknown scene '$name' (known: bumpy peanut bunny grazing peer t1-t5 v1-v5 u1-u8 b1-b3 w1-w6 l1-l8, groups main spheres bumpy-family weak held-out all low)" >&2; exit 2; }
 done
 
 runs=$out/runs/$tag

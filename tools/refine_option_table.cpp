@@ -165,10 +165,15 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(on_off("--normalize", "photo_normalize",
                      "Per-view gain/bias normalisation of the patches before the variance (on/off)",
                      [](auto& o) -> auto& { return o.photo.photo.normalize; }));
-  t.push_back(on_off("--surface-patch", "photo_surface_patch",
+  t.push_back(choice("--surface-patch", "photo_surface_patch",
                      "Patches laid on the tangent plane, the same surface points in every view, instead of whole-pixel "
-                     "image patches (on/off)",
+                     "image patches: on, off, or oblique (at the vertices with a view beyond --surface-patch-angle)",
+                     {{"off", SurfacePatchUse::Off}, {"oblique", SurfacePatchUse::Oblique}, {"on", SurfacePatchUse::On}},
                      [](auto& o) -> auto& { return o.photo.photo.surface_patch; }));
+  t.push_back(value("--surface-patch-angle", "photo_surface_patch_angle", "photo.photo.surface_patch_angle_degrees",
+                    "--surface-patch oblique: a vertex with a view farther than this from its normal (degrees) lays "
+                    "its patch on the surface",
+                    [](auto& o) -> auto& { return o.photo.photo.surface_patch_angle_degrees; }));
   t.push_back(value("--surface-patch-spacing", "photo_surface_patch_spacing", "photo.photo.surface_patch_spacing",
                     "--surface-patch: spacing of the patch points in pixels of the finest view",
                     [](auto& o) -> auto& { return o.photo.photo.surface_patch_spacing; }));

@@ -23,7 +23,7 @@ struct SliceArguments {
   std::string output;
   std::string axis = "z";
   std::string views = "nearest";
-  std::string surface_patch = "off";
+  std::string surface_patch = "oblique";
   bool linear = false;
   PhotoSliceOptions options;
 };
@@ -114,8 +114,13 @@ void add_slice_command(CLI::App& app, Runner& runner) {
       ->check(CLI::Range(1, 7))
       ->capture_default_str();
   command->add_option("--surface-patch", args->surface_patch,
-                      "on: patches laid on the nearest vertex's tangent plane, as refine --surface-patch on")
-      ->check(CLI::IsMember({"on", "off"}))
+                      "Patches laid on the nearest vertex's tangent plane (on), where one of its views is beyond "
+                      "--surface-patch-angle (oblique), or whole-pixel image patches (off), as refine --surface-patch")
+      ->check(CLI::IsMember({"off", "oblique", "on"}))
+      ->capture_default_str();
+  command->add_option("--surface-patch-angle", args->options.photo.surface_patch_angle_degrees,
+                      "--surface-patch oblique: a nearest vertex with a view farther than this from its normal "
+                      "(degrees) lays the patch on the surface (valid: (0, 90])")
       ->capture_default_str();
   command->add_option("--surface-patch-spacing", args->options.photo.surface_patch_spacing,
                       "Surface patch: spacing of its points in pixels of the finest view (valid: (0, 8])")
@@ -124,12 +129,15 @@ void add_slice_command(CLI::App& app, Runner& runner) {
   command->callback([args, &runner] {
     // The photo options' ranges are their check()'s; a value out of range is refused now, under
     // its flag (exit 2), as refine does.
-    args->options.photo.surface_patch = args->surface_patch == "on";
+    args->options.photo.surface_patch = args->surface_patch == "on"        ? SurfacePatchUse::On
+                                        : args->surface_patch == "oblique" ? SurfacePatchUse::Oblique
+                                                                           : SurfacePatchUse::Off;
     try {
       args->options.photo.check();
     } catch (const OptionError& e) {
       if (e.option() == "half_patch") throw CLI::ValidationError("--patch", e.what());
       if (e.option() == "surface_patch_spacing") throw CLI::ValidationError("--surface-patch-spacing", e.what());
+      if (e.option() == "surface_patch_angle_degrees") throw CLI::ValidationError("--surface-patch-angle", e.what());
       throw CLI::ValidationError(e.what());
     }
     runner = [args](spdlog::logger& log) { return run_slice(*args, log); };

@@ -56,12 +56,13 @@ RefineOptions thesis_preset() {
   options.stopping.test = ConvergenceTest::EachLookback;
   options.rims.fit = RimFit::Off;
   options.unobserved_displacement.spread = UnobservedSpread::Off;
+  options.photo.photo.surface_patch = SurfacePatchUse::Off;
   return options;
 }
 
 RefineOptions accurate_preset() {
   RefineOptions options = default_preset();
-  options.photo.photo.surface_patch = true;
+  options.photo.photo.surface_patch = SurfacePatchUse::On;
   // Surface-patch runs move more steadily: at 0.0025 the median net move falls below the settled
   // tolerance while a minority (the peanut's waist) is still arriving.
   options.stopping.settled_tolerance = 0.001;

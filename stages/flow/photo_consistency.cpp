@@ -19,7 +19,10 @@ void PhotoConsistencyOptions::check() const {
   require_option(min_views >= 2 && min_views <= 1000, "min_views", min_views, "[2, 1000]");
   require_option(surface_patch_spacing > 0 && surface_patch_spacing <= 8, "surface_patch_spacing",
                  surface_patch_spacing, "(0, 8]");
-  require_option(!(surface_patch && normalize), "surface_patch", surface_patch, "off when normalize is on");
+  require_option(surface_patch_angle_degrees > 0 && surface_patch_angle_degrees <= 90, "surface_patch_angle_degrees",
+                 surface_patch_angle_degrees, "(0, 90]");
+  require_option(!(surface_patch == SurfacePatchUse::On && normalize), "surface_patch", "on",
+                 "off or oblique when normalize is on");
 }
 
 namespace detail {

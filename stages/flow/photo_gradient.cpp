@@ -27,7 +27,9 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
   MVFLOW_CHECK(sample_spacing > 0, "photo gradient: sample spacing must be positive");
   const int half = options_.savitzky_golay.half_window();
   const PhotoConsistencyOptions& photo = options_.photo;
-  const bool default_patch = photo.half_patch == 2 && !photo.normalize && !photo.surface_patch;
+  // The 5×5 image patch's own kernel, where a vertex does not lay its patch on the surface.
+  const bool default_patch = photo.half_patch == 2 && !photo.normalize;
+  const bool surface_everywhere = photo.surface_patch == SurfacePatchUse::On;
   // Buffers for the whole block: no allocation per vertex.
   std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
   std::vector<ViewGainBias> maps;  // with normalisation, one per visible view
@@ -37,7 +39,8 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     const std::span<const std::uint16_t> visible = fields.visible(v);
     const Eigen::Vector3d X = position(v);
     // The next vertex's image blocks travel to the cache while this vertex's 61 samples run.
-    if (v + 1 < vertices.end && default_patch) detail::prefetch_patches(position(v + 1), fields.visible(v + 1), views);
+    if (v + 1 < vertices.end && default_patch && !surface_everywhere)
+      detail::prefetch_patches(position(v + 1), fields.visible(v + 1), views);
     std::uint8_t& defined = fields.defined[v];
     defined &= static_cast<std::uint8_t>(~(kPhotoDefined | kGradientDefined));
     fields.photo_consistency[v] = 0.0;
@@ -45,13 +48,13 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
 
     // samples[0] = g(X); samples[1 + axis·2·half + i]: s = −half..−1, 1..half (the centre is
     // shared by the axes).
-    if (default_patch) {
-      detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
-    } else if (photo.surface_patch) {
+    if (uses_surface_patch(X, fields.normal[v], visible, views, photo)) {
       layout_surface_patch(X, fields.normal[v], visible, views, photo.half_patch, photo.surface_patch_spacing, layout);
       // The next vertex's rows travel to the cache while this one's samples run.
-      if (v + 1 < vertices.end) detail::prefetch_surface_patches(position(v + 1), layout, views);
+      if (v + 1 < vertices.end && surface_everywhere) detail::prefetch_surface_patches(position(v + 1), layout, views);
       surface_patch_samples(X, sample_spacing, half, layout, views, samples);
+    } else if (default_patch) {
+      detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
     } else if (photo.normalize) {
       // One map per view, taken at X, for every sample: g stays smooth along the sample lines.
       gain_bias_at(X, visible, views, photo.half_patch, photo.noise_floor, maps);

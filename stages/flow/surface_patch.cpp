@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "engine/model/error.h"
 #include "stages/flow/photo_kernel.h"
@@ -102,10 +103,23 @@ void detail::prefetch_surface_patches(const Eigen::Vector3d& X, const SurfacePat
   }
 }
 
+bool uses_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, std::span<const std::uint16_t> view_ids,
+                        const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options) {
+  if (options.surface_patch == SurfacePatchUse::On) return true;
+  // Without a normal no view is oblique: the image patch, as the flow's visibility has no views then.
+  if (options.surface_patch == SurfacePatchUse::Off || options.normalize || !(N.squaredNorm() > 0)) return false;
+  const double cos_oblique = std::cos(options.surface_patch_angle_degrees * std::numbers::pi / 180.0);
+  for (const std::uint16_t id : view_ids) {
+    const Eigen::Vector3d to_camera = views[id].camera->centre() - X;
+    if (N.dot(to_camera) < cos_oblique * to_camera.norm()) return true;
+  }
+  return false;
+}
+
 PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
                                         std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
                                         const PhotoConsistencyOptions& options, SurfacePatchLayout& layout) {
-  if (!options.surface_patch) return photo_consistency(X, view_ids, views, options);
+  if (!uses_surface_patch(X, N, view_ids, views, options)) return photo_consistency(X, view_ids, views, options);
   layout_surface_patch(X, N, view_ids, views, options.half_patch, options.surface_patch_spacing, layout);
   return surface_patch_consistency(X, layout, views);
 }

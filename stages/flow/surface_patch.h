@@ -71,8 +71,14 @@ void prefetch_surface_patches(const Eigen::Vector3d& X, const SurfacePatchLayout
                               const std::vector<PhotoView>& views);
 }  // namespace detail
 
+//! Whether g at the surface point \p X with outward unit normal \p N over \p view_ids lays its
+//! patch on the surface (options.surface_patch): always with On, never with Off or normalize, and
+//! with Oblique when one of the views is farther than options.surface_patch_angle_degrees from N.
+bool uses_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, std::span<const std::uint16_t> view_ids,
+                        const std::vector<PhotoView>& views, const PhotoConsistencyOptions& options);
+
 //! g at the surface point \p X with outward unit normal \p N as the options say: the surface
-//! patch (laid out in \p layout, reused between calls) when options.surface_patch, else
+//! patch (laid out in \p layout, reused between calls) where uses_surface_patch(), else
 //! photo_consistency().
 PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
                                         std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
