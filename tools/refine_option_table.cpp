@@ -168,7 +168,9 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(choice("--surface-patch", "photo_surface_patch",
                      "Patches laid on the tangent plane, the same surface points in every view, instead of whole-pixel "
                      "image patches: on, off, or oblique (at the vertices with a view beyond --surface-patch-angle)",
-                     {{"off", SurfacePatchUse::Off}, {"oblique", SurfacePatchUse::Oblique}, {"on", SurfacePatchUse::On}},
+                     {{"off", SurfacePatchUse::Off},
+                      {"oblique", SurfacePatchUse::Oblique},
+                      {"on", SurfacePatchUse::On}},
                      [](auto& o) -> auto& { return o.photo.photo.surface_patch; }));
   t.push_back(value("--surface-patch-angle", "photo_surface_patch_angle", "photo.photo.surface_patch_angle_degrees",
                     "--surface-patch oblique: a vertex with a view farther than this from its normal (degrees) lays "

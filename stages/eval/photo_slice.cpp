@@ -71,7 +71,8 @@ PhotoSlice compute_photo_slice(const TriMesh& mesh, const std::vector<PhotoView>
   std::vector<std::uint16_t> all_views(views.size());
   for (std::size_t i = 0; i < views.size(); ++i) all_views[i] = static_cast<std::uint16_t>(i);
   // The nearest vertex gives the views (NearestVertex) and the surface patch's normal.
-  const bool nearest_vertex = options.views == SliceViews::NearestVertex || options.photo.surface_patch != SurfacePatchUse::Off;
+  const bool nearest_vertex =
+      options.views == SliceViews::NearestVertex || options.photo.surface_patch != SurfacePatchUse::Off;
   if (nearest_vertex) {
     fields.resize(mesh.n_vertices(), views.size());
     const IndexRange everything{0, static_cast<std::uint32_t>(mesh.n_vertices())};
