@@ -131,7 +131,7 @@ int run(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-refine", [&](std::int64_t) { settings.whole_refinement = false; },
                "Skip the whole refinement (fixed-topology iterations only)");
-  std::string surface_patch = "oblique";
+  std::string surface_patch = to_string(settings.surface_patch);
   app.add_option("--surface-patch", surface_patch,
                  "Grid suite: patches on the surface at oblique vertices (the default), everywhere (on) or nowhere "
                  "(off), as refine --surface-patch")
@@ -146,9 +146,7 @@ int run(int argc, char** argv) {
   app.add_flag("--no-validate", no_validate, "Do not check that every configuration gives the same mesh (nor that "
                                              "the suites' refinements lower Σg or the error)");
   CLI11_PARSE(app, argc, argv);
-  settings.surface_patch = surface_patch == "on"    ? SurfacePatchUse::On
-                          : surface_patch == "off" ? SurfacePatchUse::Off
-                                                   : SurfacePatchUse::Oblique;
+  settings.surface_patch = surface_patch_use_from_string(surface_patch);
   if (quick && sizes.empty()) sizes = {"1k/8/640x480", "10k/16/640x480"};
   if (sizes.empty()) sizes = full_grid();
   // Before the runs, which take minutes to hours: an unwritable output is known at once.

@@ -1071,6 +1071,12 @@ TEST(SurfacePatch, OptionsOutOfRangeAreRefused) {
     options.surface_patch_angle_degrees = angle;
     EXPECT_THROW(options.check(), OptionError) << angle;
   }
+  // The command line's names, both ways.
+  for (const SurfacePatchUse use : {SurfacePatchUse::Off, SurfacePatchUse::Oblique, SurfacePatchUse::On})
+    EXPECT_EQ(surface_patch_use_from_string(to_string(use)), use);
+  EXPECT_STREQ(to_string(SurfacePatchUse::Oblique), "oblique");
+  EXPECT_THROW(surface_patch_use_from_string("yes"), InputError);
+  EXPECT_THROW(surface_patch_use_from_string(""), InputError);
 }
 
 // SurfacePatchUse::Oblique: a vertex lays its patch on the surface exactly when one of its views is

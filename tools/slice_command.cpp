@@ -23,7 +23,7 @@ struct SliceArguments {
   std::string output;
   std::string axis = "z";
   std::string views = "nearest";
-  std::string surface_patch = "oblique";
+  std::string surface_patch = to_string(PhotoConsistencyOptions{}.surface_patch);  // refine's default
   bool linear = false;
   PhotoSliceOptions options;
 };
@@ -129,9 +129,7 @@ void add_slice_command(CLI::App& app, Runner& runner) {
   command->callback([args, &runner] {
     // The photo options' ranges are their check()'s; a value out of range is refused now, under
     // its flag (exit 2), as refine does.
-    args->options.photo.surface_patch = args->surface_patch == "on"        ? SurfacePatchUse::On
-                                        : args->surface_patch == "oblique" ? SurfacePatchUse::Oblique
-                                                                           : SurfacePatchUse::Off;
+    args->options.photo.surface_patch = surface_patch_use_from_string(args->surface_patch);
     try {
       args->options.photo.check();
     } catch (const OptionError& e) {

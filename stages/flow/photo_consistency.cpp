@@ -12,6 +12,21 @@
 
 namespace mvflow {
 
+const char* to_string(SurfacePatchUse use) {
+  switch (use) {
+    case SurfacePatchUse::Off: return "off";
+    case SurfacePatchUse::Oblique: return "oblique";
+    case SurfacePatchUse::On: return "on";
+  }
+  return "?";
+}
+
+SurfacePatchUse surface_patch_use_from_string(std::string_view name) {
+  for (const SurfacePatchUse use : {SurfacePatchUse::Off, SurfacePatchUse::Oblique, SurfacePatchUse::On})
+    if (name == to_string(use)) return use;
+  throw InputError("surface patch: expected off, oblique or on, got '" + std::string(name) + "'");
+}
+
 void PhotoConsistencyOptions::check() const {
   require_option(half_patch >= 1 && half_patch <= 7, "half_patch", half_patch, "[1, 7]");
   require_option(noise_floor >= 0 && noise_floor <= 1, "noise_floor", noise_floor, "[0, 1]");
@@ -21,7 +36,7 @@ void PhotoConsistencyOptions::check() const {
                  surface_patch_spacing, "(0, 8]");
   require_option(surface_patch_angle_degrees > 0 && surface_patch_angle_degrees <= 90, "surface_patch_angle_degrees",
                  surface_patch_angle_degrees, "(0, 90]");
-  require_option(!(surface_patch == SurfacePatchUse::On && normalize), "surface_patch", "on",
+  require_option(!(surface_patch == SurfacePatchUse::On && normalize), "surface_patch", to_string(surface_patch),
                  "off or oblique when normalize is on");
 }
 

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "engine/model/mesh.h"
@@ -26,6 +27,12 @@ enum class SurfacePatchUse : std::uint8_t {
   Oblique,  //!< surface patches where a view is beyond surface_patch_angle_degrees, else whole-pixel
   On,       //!< surface patches everywhere
 };
+
+//! The command line's name of \p use: "off", "oblique" or "on".
+const char* to_string(SurfacePatchUse use);
+//! The SurfacePatchUse called \p name ("off", "oblique" or "on").
+//! \throw InputError naming the valid names otherwise.
+SurfacePatchUse surface_patch_use_from_string(std::string_view name);
 
 struct PhotoConsistencyOptions {
   int half_patch = 2;  //!< patch of (2·half_patch+1)² pixels; 2 = the thesis's 5×5 (range 1..7)
