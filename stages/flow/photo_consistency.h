@@ -52,7 +52,7 @@ struct PhotoConsistencyOptions {
   //! 1/cos θ more surface in a view at θ to the normal). Needs the vertex normal. Oblique by
   //! default: on 32 synthetic scenes 0.860× the error of Off (better by > 3 % on 24, worse on
   //! none; On at the same settled tolerance 0.863×, worse on 4), held-out error of the photographs
-  //! −26.6 % / −16.7 % against the hull (Off −27.2 % / −15.0 %), for 1.10–1.23× Off's time where
+  //! −26.6 % / −16.7 % against the hull (Off −27.2 % / −15.0 %), for 1.10–1.25× Off's time where
   //! On takes 1.14–1.45× (README, "Surface patches at oblique vertices"). On cannot go with
   //! normalize; Oblique leaves normalized patches as they are. Off: the thesis.
   SurfacePatchUse surface_patch = SurfacePatchUse::Oblique;
