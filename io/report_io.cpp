@@ -19,6 +19,8 @@ nlohmann::json iteration_json(const IterationReport& r) {
           {"sum_g", r.sum_g},
           {"sum_g_per_vertex", r.sum_g_per_vertex()},
           {"defined_g", r.defined_g},
+          {"surface_patch_g", r.surface_patch_g},
+          {"patch_switches", r.patch_switches},
           {"moving_vertices", r.moving},
           {"shortest_edge", r.shortest_edge},
           {"max_speed", r.max_speed},

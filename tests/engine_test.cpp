@@ -134,6 +134,8 @@ void expect_same_bits(const RefineOptions& options) {
     for (std::size_t i = 0; i < reference.summary.iterations.size(); ++i) {
       EXPECT_EQ(other->summary.iterations[i].sum_g, reference.summary.iterations[i].sum_g);
       EXPECT_EQ(other->summary.iterations[i].time_step, reference.summary.iterations[i].time_step);
+      EXPECT_EQ(other->summary.iterations[i].surface_patch_g, reference.summary.iterations[i].surface_patch_g);
+      EXPECT_EQ(other->summary.iterations[i].patch_switches, reference.summary.iterations[i].patch_switches);
     }
   }
 }
@@ -171,6 +173,38 @@ TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {
   EXPECT_EQ(result.summary.initial_faces, s.initial.n_faces());
   EXPECT_EQ(result.mesh.quality.size(), result.mesh.n_vertices());
   EXPECT_EQ(result.mesh.colors.size(), result.mesh.n_vertices());
+}
+
+TEST(Refiner, ReportsTheVerticesWhoseGLaidItsPatchOnTheSurfaceAndTheSwitches) {
+  const SmallScene& s = small_scene();
+  const auto run = [&](SurfacePatchUse use) {
+    RefineOptions options = few_iterations(8);
+    options.photo.photo.surface_patch = use;
+    const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
+    EXPECT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+    EXPECT_FALSE(result.summary.iterations.empty());
+    return result.summary.iterations;
+  };
+  for (const IterationReport& r : run(SurfacePatchUse::On)) {
+    EXPECT_GT(r.defined_g, 0u);
+    EXPECT_EQ(r.surface_patch_g, r.defined_g) << r.iteration;
+    EXPECT_EQ(r.patch_switches, 0u) << r.iteration;
+  }
+  for (const IterationReport& r : run(SurfacePatchUse::Off)) {
+    EXPECT_EQ(r.surface_patch_g, 0u) << r.iteration;
+    EXPECT_EQ(r.patch_switches, 0u) << r.iteration;
+  }
+  // The ring of 16 views sees the poles obliquely: some vertices of each kind, and some switch as
+  // the normals change (none in the first iteration, which has nothing to switch from).
+  const std::vector<IterationReport> oblique = run(SurfacePatchUse::Oblique);
+  EXPECT_EQ(oblique.front().patch_switches, 0u);
+  std::size_t switches = 0;
+  for (const IterationReport& r : oblique) {
+    EXPECT_GT(r.surface_patch_g, 0u) << r.iteration;
+    EXPECT_LT(r.surface_patch_g, r.defined_g) << r.iteration;
+    switches += r.patch_switches;
+  }
+  EXPECT_GT(switches, 0u);
 }
 
 TEST(Refiner, RefinesCoarseToFineWhenTheFlowHasConverged) {

@@ -1147,5 +1147,43 @@ TEST(SurfacePatch, ObliqueVerticesAloneUseSurfacePatches) {
             photo_consistency(X, frontal, scene.views).g);
 }
 
+TEST(SurfacePatch, TheGradientStageRecordsEachVertexsKindAndItsSwitches) {
+  const PlaneScene scene = oblique_plane_scene();  // views at 0°, 35°, 60° and 65° from the normal
+  Mesh mesh;
+  for (double x = -6; x <= 6; x += 3) mesh.topology.add_vertex(to_openmesh(Eigen::Vector3d(x, 0.4 * x, 0.5)));
+  VertexFields fields;
+  fields.resize(mesh.n_vertices(), scene.views.size());
+  const auto run = [&](auto with_the_65_degree_view) {  // views 0–1 (image patch) or 0–3 (surface patch)
+    for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+      fields.normal[v] = Eigen::Vector3d::UnitZ();
+      fields.visible_count[v] = with_the_65_degree_view(v) ? 4 : 2;
+      std::copy(scene.all.begin(), scene.all.end(), fields.visible_views.begin() + v * fields.view_capacity);
+    }
+    const PhotoGradientStage stage{PhotoGradientOptions{}};  // Oblique at 60°
+    stage.run(mesh.topology, {0, static_cast<std::uint32_t>(mesh.n_vertices())}, scene.views, stage.sample_spacing(4.0),
+              fields);
+  };
+  const auto odd = [](std::size_t v) { return v % 2 == 1; };
+  const auto even = [](std::size_t v) { return v % 2 == 0; };
+  const auto expect = [&](auto surface, auto switched, const char* when) {
+    for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+      EXPECT_EQ(fields.patch_kind[v], surface(v) ? PatchKind::Surface : PatchKind::Image) << when << ", vertex " << v;
+      EXPECT_EQ((fields.defined[v] & kPatchSwitched) != 0, switched(v)) << when << ", vertex " << v;
+    }
+  };
+  ASSERT_EQ(fields.patch_kind[0], PatchKind::Undecided);
+  run(odd);
+  expect(odd, [](std::size_t) { return false; }, "first evaluation");  // nothing to switch from
+  run(odd);
+  expect(odd, [](std::size_t) { return false; }, "the same views again");
+  run(even);
+  expect(even, [](std::size_t) { return true; }, "the other views");
+  run([](std::size_t v) { return v == 0 || v == 1; });
+  expect([](std::size_t v) { return v == 0 || v == 1; }, [](std::size_t v) { return v == 1 || (v != 0 && v % 2 == 0); },
+         "vertices 0 and 1 with the 65° view");
+  fields.resize(mesh.n_vertices(), scene.views.size());  // a new topology
+  EXPECT_EQ(fields.patch_kind[1], PatchKind::Undecided);
+}
+
 }  // namespace
 }  // namespace mvflow

@@ -30,6 +30,10 @@ struct IterationReport {
   std::size_t declined_vertices = 0;
   double sum_g = 0.0;                 //!< Σ g over vertices with defined g (the stopping criterion's G_i)
   std::size_t defined_g = 0;          //!< vertices with defined g
+  //! of those, the vertices whose g laid its patch on the surface (PhotoConsistencyOptions::surface_patch)
+  std::size_t surface_patch_g = 0;
+  //! vertices whose g took the other kind of patch than in the previous iteration of this mesh
+  std::size_t patch_switches = 0;
   std::size_t moving = 0;             //!< vertices with a defined speed
   double shortest_edge = 0.0;         //!< e_min of the mesh the iteration started from
   double max_speed = 0.0;             //!< max |F|

@@ -16,6 +16,7 @@ void VertexFields::resize(std::size_t n_vertices, std::size_t n_views) {
   speed.assign(n_vertices, Eigen::Vector3d::Zero());
   local_edge.assign(n_vertices, 0.0);
   defined.assign(n_vertices, 0);
+  patch_kind.assign(n_vertices, PatchKind::Undecided);
   view_capacity = n_views;
   visible_views.assign(n_vertices * n_views, 0);
   visible_count.assign(n_vertices, 0);

@@ -22,7 +22,14 @@ enum VertexDefined : std::uint8_t {
   //! F was not observed (no defined g or ∇g) but taken from observed neighbours
   //! (stages/flow/unobserved_speed.h): the vertex moves, the step size and stopping rules ignore it.
   kSpeedFilled = 1u << 5,
+  //! g's patch is of another kind than in the previous iteration of this mesh (PatchKind)
+  kPatchSwitched = 1u << 6,
 };
+
+//! The kind of patch g used at a vertex in the last evaluation of its gradient
+//! (PhotoConsistencyOptions::surface_patch): kept between iterations of one mesh, so that the
+//! report can count the vertices that switch kind; Undecided after a change of topology.
+enum class PatchKind : std::uint8_t { Undecided = 0, Image, Surface };
 
 struct VertexFields {
   std::vector<Eigen::Vector3d> normal;       //!< outward unit normal N
@@ -36,6 +43,7 @@ struct VertexFields {
   std::vector<Eigen::Vector3d> speed;        //!< F
   std::vector<double> local_edge;            //!< shortest edge at the vertex (the local CFL length)
   std::vector<std::uint8_t> defined;         //!< VertexDefined bits
+  std::vector<PatchKind> patch_kind;         //!< the patch g used at the vertex last (see PatchKind)
   //! Visible views of vertex v: visible_views[v·view_capacity + 0 .. visible_count[v]-1].
   std::vector<std::uint16_t> visible_views;
   std::vector<std::uint16_t> visible_count;

@@ -148,8 +148,14 @@ void IterationData::cfl() {
   // additions differently for another block size, and Σg steers the stopping rule, so it must
   // not depend on the blocking (a max and a count do not).
   double sum_g = 0.0;
-  for (std::size_t v = 0; v < fields.size(); ++v)
-    if (fields.defined[v] & kPhotoDefined) sum_g += fields.photo_consistency[v];
+  surface_patch_g = patch_switches = 0;
+  for (std::size_t v = 0; v < fields.size(); ++v) {
+    patch_switches += (fields.defined[v] & kPatchSwitched) != 0;
+    if (fields.defined[v] & kPhotoDefined) {
+      sum_g += fields.photo_consistency[v];
+      surface_patch_g += fields.patch_kind[v] == PatchKind::Surface;
+    }
+  }
   total.sum_g = sum_g;
   // Before the step: weakly seen vertices only follow it, so they leave the maximum too.
   if (demote_weakly_seen(mesh, views, options.unobserved, fields) > 0) {

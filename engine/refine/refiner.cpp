@@ -488,6 +488,8 @@ class Refinement {
     report.faces = mesh_.n_faces();
     report.sum_g = data_.total.sum_g;
     report.defined_g = data_.total.defined_g;
+    report.surface_patch_g = data_.surface_patch_g;
+    report.patch_switches = data_.patch_switches;
     report.moving = data_.moving;
     report.shortest_edge = edges.shortest;
     report.max_speed = data_.total.max_speed;

@@ -42,13 +42,19 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     if (v + 1 < vertices.end && default_patch && !surface_everywhere)
       detail::prefetch_patches(position(v + 1), fields.visible(v + 1), views);
     std::uint8_t& defined = fields.defined[v];
-    defined &= static_cast<std::uint8_t>(~(kPhotoDefined | kGradientDefined));
+    defined &= static_cast<std::uint8_t>(~(kPhotoDefined | kGradientDefined | kPatchSwitched));
     fields.photo_consistency[v] = 0.0;
     fields.photo_gradient[v].setZero();
 
     // samples[0] = g(X); samples[1 + axis·2·half + i]: s = −half..−1, 1..half (the centre is
     // shared by the axes).
-    if (uses_surface_patch(X, fields.normal[v], visible, views, photo)) {
+    // The kind of patch is decided afresh every iteration; the previous one is kept only to count
+    // the switches (a hysteresis of ±5° or ±10° around the angle was worse: README).
+    const bool surface = uses_surface_patch(X, fields.normal[v], visible, views, photo);
+    const PatchKind kind = surface ? PatchKind::Surface : PatchKind::Image;
+    if (fields.patch_kind[v] != PatchKind::Undecided && fields.patch_kind[v] != kind) defined |= kPatchSwitched;
+    fields.patch_kind[v] = kind;
+    if (surface) {
       layout_surface_patch(X, fields.normal[v], visible, views, photo.half_patch, photo.surface_patch_spacing, layout);
       // The next vertex's rows travel to the cache while this one's samples run.
       if (v + 1 < vertices.end && surface_everywhere) detail::prefetch_surface_patches(position(v + 1), layout, views);
