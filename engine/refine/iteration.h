@@ -79,11 +79,13 @@ struct IterationData {
   //! Set by measure_moves(): the median over the moving vertices of their move divided by the
   //! edge the CFL bound used for them (their own shortest edge, or e_min with the global bound).
   double median_move = 0.0;
-  std::size_t surface_patch_g = 0;  //!< vertices with defined g from a surface patch (cfl())
-  std::size_t patch_switches = 0;   //!< vertices whose patch kind changed this iteration (cfl())
   //! Set by measure_moves(): NetNormalMove::record over options.stopping.lookback iterations (NaN
   //! until that many ran on this topology).
   double net_move_over_edge = 0.0;
+  //! Set by cfl(): the vertices with defined g from a surface patch, and those whose kind of patch
+  //! changed since the previous iteration (VertexFields::patch_kind).
+  std::size_t surface_patch_g = 0;
+  std::size_t patch_switches = 0;
   std::size_t moving = 0;
   double serial_seconds[kStageCount] = {};
 
