@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # tools/quality_scenes.sh on issue 12's grazing rig: its line must agree with `mvflow eval`'s JSON
 # and with the south cap's error computed here, independently, from an OBJ copy of the refined
-# mesh, and its item-5 verdict with the line's own figures; --compare of a run with itself must
-# give 1.000 and identical meshes, with a shorter run its ratio and none; an unknown scene name is
-# refused before any work, and a refinement that fails makes it exit 1.
+# mesh, its surface-patch share with the report's counts, and its item-5 verdict with the line's
+# own figures; --compare of a run with itself must give 1.000 and identical meshes, with a shorter
+# run its ratio and none; an unknown scene name is refused before any work, and a refinement that
+# fails makes it exit 1.
 #   tests/quality_scenes_check.sh MVFLOW SOURCE_DIR WORK_DIR
 set -euo pipefail
 mvflow=$1 root=$2 work=$3
@@ -50,6 +51,9 @@ for text, degrees in ((line, 20), (open(f'{work}/d.txt').read(), 30)):
 report = json.load(open(f'{work}/runs/a/grazing.json'))
 noise = float(re.search(r'image noise (\S+?)(?: \||$)', line.strip()).group(1))
 assert abs(noise - report['initial']['image_noise']) < 6e-6, (noise, report['initial']['image_noise'])
+share = float(re.search(r'surface patches (\S+) %', line).group(1))
+expected_share = 100 * sum(i['surface_patch_g'] for i in report['iterations']) / sum(i['defined_g'] for i in report['iterations'])
+assert 0 < expected_share < 100 and abs(share - expected_share) < 0.051, (share, expected_share)
 # Issue 12's item 5 on the unit spheres, from the line's own figures.
 accuracy = float(re.search(r'acc (\S+)', line).group(1))
 iterations = int(re.search(r'(\d+) it\.', line).group(1))

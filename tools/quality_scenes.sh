@@ -16,7 +16,9 @@
 # and bumpy spheres on small rigs (320×240 but l7, 12 views but l5), held out from every choice
 # and not in all, so that all stays the 32 of earlier runs. The scenes go to OUT/scenes/NAME (rendered only when missing, so
 # every TAG is scored on the same photographs), the runs to OUT/runs/TAG/NAME.{ply,json,eval.json},
-# one line per scene to OUT/runs/TAG/summary.txt and stdout. On the unit spheres "cap" is the mean
+# one line per scene to OUT/runs/TAG/summary.txt and stdout, with the share of the vertices
+# whose g laid its patch on the surface over the run (the report's surface_patch_g over
+# defined_g, summed over the iterations). On the unit spheres "cap" is the mean
 # radial error of the vertices beyond 55° latitude on the side the rig sees worst (south for
 # grazing, peer, t3 and u1–u3, u5, u6, u8; north for v5, u4 and u7, whose upper ring is lowest)
 # over that of all others (issue 12 asks ≤ 2), followed by the mean signed radial error of the
@@ -194,6 +196,9 @@ e = json.load(open(run + '.eval.json')); r = json.load(open(run + '.json'))
 line = (f"{name:8s} mean {e['symmetric_mean']:.5f} acc {e['accuracy']:.5f} "
         f"complete {100 * e['completeness']:.3f}% | {r['final']['vertices']} v., "
         f"{len(r['iterations'])} it., {r['status']}, {r['seconds']:.2f} s, image noise {r['initial']['image_noise']:.5f}")
+defined = sum(i['defined_g'] for i in r['iterations'])
+if defined and all('surface_patch_g' in i for i in r['iterations']):  # (not in reports before session 25)
+    line += f" | surface patches {100 * sum(i['surface_patch_g'] for i in r['iterations']) / defined:.1f} %"
 data = open(run + '.ply', 'rb').read() if cap_side else b''
 if cap_side and b'format binary_little_endian' not in data[:200]:
     line += ' | cap: needs a binary little-endian PLY (refine without --ascii)'
