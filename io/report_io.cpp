@@ -44,6 +44,7 @@ nlohmann::json report_to_json(const RefineSummary& summary, const nlohmann::json
           {"initial", {{"vertices", summary.initial_vertices}, {"faces", summary.initial_faces},
                        {"sum_g_per_vertex", summary.initial_sum_g_per_vertex},
                        {"image_noise", summary.image_noise},
+                       {"denoise_sigma", summary.denoise_sigma},
                        {"settled_tolerance", summary.settled_tolerance}}},
           {"final", {{"vertices", summary.final_vertices}, {"faces", summary.final_faces},
                      {"sum_g_per_vertex", summary.final_sum_g_per_vertex},

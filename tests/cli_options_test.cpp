@@ -32,6 +32,8 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--min-views", {"4", 4}},
       {"--image-levels", {"2", 2}},
       {"--normalize", {"on", true}},
+      {"--denoise", {"off", "off"}},
+      {"--denoise-reference", {"0.004", 0.004}},
       {"--surface-patch", {"on", "on"}},
       {"--surface-patch-angle", {"50", 50.0}},
       {"--surface-patch-spacing", {"3", 3.0}},
@@ -154,7 +156,8 @@ TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
         {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"},
-        {"--hardly-observed-first", "-0.1"}, {"--settle-noise-reference", "-0.001"}}) {
+        {"--hardly-observed-first", "-0.1"}, {"--settle-noise-reference", "-0.001"},
+        {"--denoise", "on"}, {"--denoise-reference", "0"}}) {
     EXPECT_THROW(options_after(bad), CLI::ParseError) << bad[0] << " " << bad[1];
   }
 }

@@ -1,4 +1,5 @@
-// The photographs' noise (stages/flow/image_noise.h): Immerkær's estimate against known cases.
+// The photographs' noise (stages/flow/image_noise.h): Immerkær's estimate against known cases; and
+// the blur that removes it (stages/flow/image_denoise.h) against analytic and measured noise.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +11,7 @@
 
 #include "engine/model/image.h"
 #include "engine/model/option_check.h"
+#include "stages/flow/image_denoise.h"
 #include "stages/flow/image_noise.h"
 #include "stages/flow/stopping.h"
 
@@ -140,6 +142,119 @@ TEST(ImageNoise, CleanEightBitImagesKeepTheToleranceNoisyOnesRaiseIt) {
   const double noisy = estimate_image_noise(eight_bit(ramp(0.01, 7)));
   EXPECT_NEAR(noisy, 0.01, 0.0005);
   EXPECT_NEAR(settled_tolerance_for_noise(options, noisy), 0.0025 * std::sqrt(noisy / 0.002), 1e-12);
+}
+
+// The 1-D Gaussian taps at the integers within ⌈3σ⌉, normalised: written here from the formula,
+// not taken from the code under test.
+std::vector<double> reference_taps(double sigma) {
+  const int radius = static_cast<int>(std::ceil(3.0 * sigma));
+  std::vector<double> taps;
+  for (int i = -radius; i <= radius; ++i) taps.push_back(std::exp(-(i * i) / (2.0 * sigma * sigma)));
+  double sum = 0.0;
+  for (double w : taps) sum += w;
+  for (double& w : taps) w /= sum;
+  return taps;
+}
+
+TEST(ImageDenoise, AnImpulseBecomesTheKernelAndAConstantStays) {
+  const int size = 21, centre = 10;
+  const double sigma = 1.3;
+  std::vector<float> rgb(size * size * 3, 0.0f);
+  for (int c = 0; c < 3; ++c) rgb[(centre * size + centre) * 3 + c] = static_cast<float>(c + 1);
+  const Image blurred = gaussian_blur(Image(size, size, rgb), sigma);
+  const std::vector<double> w = reference_taps(sigma);
+  const int radius = static_cast<int>(w.size() / 2);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const int dx = x - centre, dy = y - centre;
+      const double expected = std::abs(dx) <= radius && std::abs(dy) <= radius ? w[dx + radius] * w[dy + radius] : 0.0;
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(blurred.data()[(y * size + x) * 3 + c], (c + 1) * expected, 1e-7) << x << ", " << y;
+    }
+  // A constant stays constant up to the border (the border pixel repeats).
+  const Image flat = gaussian_blur(Image(9, 7, std::vector<float>(9 * 7 * 3, 0.25f)), 2.0);
+  for (std::size_t i = 0; i < 9 * 7 * 3; ++i) EXPECT_NEAR(flat.data()[i], 0.25f, 1e-7);
+  // σ ≤ 0: the image as given.
+  const Image same = gaussian_blur(blurred, 0.0);
+  EXPECT_TRUE(std::equal(same.data(), same.data() + size * size * 3, blurred.data()));
+}
+
+// White noise of σ keeps σ·Σw² after the blur (the 2-D kernel's Σ(w_x w_y)² = (Σw²)²): the gain
+// against the formula, against the continuous Gaussian's 1/(2√π σ) for a wide kernel, and against
+// the measured standard deviation of blurred noise.
+TEST(ImageDenoise, TheNoiseGainIsWhatBlurredWhiteNoiseKeeps) {
+  for (const double sigma : {0.5, 0.82, 1.7}) {
+    double expected = 0.0;
+    for (double w : reference_taps(sigma)) expected += w * w;
+    EXPECT_NEAR(gaussian_noise_gain(sigma), expected, 1e-15) << sigma;
+  }
+  // (0.3 % above it: cut at 3σ and normalised, the taps are slightly larger.)
+  EXPECT_NEAR(gaussian_noise_gain(3.0) * 2.0 * std::sqrt(std::numbers::pi) * 3.0, 1.0, 0.004);
+  EXPECT_EQ(gaussian_noise_gain(0.0), 1.0);
+  const int width = 640, height = 480;
+  std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3);
+  std::mt19937 random(11);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (float& value : rgb) value = static_cast<float>(0.5 + noise(random));
+  for (const double sigma : {0.6, 0.82, 1.5}) {
+    const Image blurred = gaussian_blur(Image(width, height, rgb), sigma);
+    double sum = 0.0, squares = 0.0;
+    std::size_t n = 0;
+    for (int y = 8; y < height - 8; ++y)  // away from the repeated border
+      for (int x = 8; x < width - 8; ++x)
+        for (int c = 0; c < 3; ++c, ++n) {
+          const double v = blurred.data()[(static_cast<std::size_t>(y) * width + x) * 3 + c];
+          sum += v;
+          squares += v * v;
+        }
+    const double deviation = std::sqrt(squares / n - (sum / n) * (sum / n));
+    EXPECT_NEAR(deviation / (0.01 * gaussian_noise_gain(sigma)), 1.0, 0.02) << sigma;
+  }
+}
+
+TEST(ImageDenoise, TheChosenBlurBringsTheNoiseToTheReference) {
+  EXPECT_EQ(denoise_sigma_for(0.0015, 0.002), 0.0);  // at or below the reference: none
+  EXPECT_EQ(denoise_sigma_for(0.002, 0.002), 0.0);
+  for (const double noise : {0.003, 0.0058, 0.02}) {
+    const double sigma = denoise_sigma_for(noise, 0.002);
+    EXPECT_GT(sigma, 0.0);
+    EXPECT_NEAR(gaussian_noise_gain(sigma), 0.002 / noise, 1e-9) << noise;
+    EXPECT_LE(noise * gaussian_noise_gain(sigma), 0.002 * (1 + 1e-12)) << noise;
+  }
+  EXPECT_EQ(denoise_sigma_for(10.0, 0.002), 8.0);  // beyond what any blur here removes: the widest
+  EXPECT_THROW((DenoiseOptions{.noise_reference = 0.0}).check(), OptionError);
+  EXPECT_THROW((DenoiseOptions{.noise_reference = NAN}).check(), OptionError);
+  // On a noisy ramp: the blurred image minus the blurred clean ramp (the blur is linear) is the
+  // noise left, measured here.
+  const Image noisy = ramp(0.0058, 21), clean = ramp(0.0);
+  const double sigma = denoise_sigma_for(0.0058, 0.002);
+  const Image a = gaussian_blur(noisy, sigma), b = gaussian_blur(clean, sigma);
+  double squares = 0.0;
+  std::size_t n = 0;
+  for (int y = 8; y < a.height() - 8; ++y)
+    for (int x = 8; x < a.width() - 8; ++x, ++n) {
+      const double d = a.data()[(static_cast<std::size_t>(y) * a.width() + x) * 3] - b.data()[(static_cast<std::size_t>(y) * a.width() + x) * 3];
+      squares += d * d;
+    }
+  EXPECT_NEAR(std::sqrt(squares / n), 0.002, 0.00006);
+}
+
+TEST(ImageDenoise, BlurredViewsKeepTheirCamerasAndBlurEveryImage) {
+  const std::vector<Image> images = {ramp(0.01, 31), ramp(0.01, 32)};
+  Eigen::Matrix3d K;
+  K << 500, 0, 320, 0, 500, 240, 0, 0, 1;
+  const std::vector<Camera> cameras = {Camera(K, Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 2), 640, 480),
+                                       Camera(K, Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.5, 0, 2), 640, 480)};
+  std::vector<const Image*> pointers = {&images[0], &images[1]};
+  const std::vector<PhotoView> views = make_photo_views(cameras, pointers);
+  const auto level = blurred_views(views, 0.9);
+  ASSERT_EQ(level->views.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const Image expected = gaussian_blur(images[i], 0.9);
+    EXPECT_TRUE(std::equal(expected.data(), expected.data() + 640 * 480 * 3, level->views[i].image->data())) << i;
+    EXPECT_EQ(level->views[i].projection, views[i].projection);
+    EXPECT_NE(level->views[i].image, views[i].image);
+  }
 }
 
 }  // namespace

@@ -162,6 +162,13 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(value("--image-levels", "image_levels", "image_levels",
                     "Start on the photographs halved this many times, one level finer each time the flow settles",
                     [](auto& o) -> auto& { return o.image_levels; }));
+  t.push_back(choice("--denoise", "denoise",
+                     "Photographs whose estimated noise is above --denoise-reference are blurred (Gaussian) just "
+                     "enough to bring it there before the flow reads them: auto or off (thesis preset: off)",
+                     {{"auto", DenoiseUse::Auto}, {"off", DenoiseUse::Off}}, [](auto& o) -> auto& { return o.denoise.use; }));
+  t.push_back(value("--denoise-reference", "denoise_noise_reference", "denoise.noise_reference",
+                    "--denoise auto: the noise σ (on [0, 1]) the photographs are blurred down to",
+                    [](auto& o) -> auto& { return o.denoise.noise_reference; }));
   t.push_back(on_off("--normalize", "photo_normalize",
                      "Per-view gain/bias normalisation of the patches before the variance (on/off)",
                      [](auto& o) -> auto& { return o.photo.photo.normalize; }));
@@ -249,7 +256,8 @@ std::vector<RefineOptionEntry> make_table() {
                     [](auto& o) -> auto& { return o.stopping.settled_tolerance; }));
   t.push_back(value("--settle-noise-reference", "settled_noise_reference", "stopping.settled_noise_reference",
                     "Photographs noisier than this (σ on [0, 1], estimated from them) raise the settled tolerance by "
-                    "√(σ / this) (0 = off; clean renders and photographs here read 0.0006–0.0018, README \"Convergence\")",
+                    "√(σ / this), σ after --denoise (0 = off; clean renders and photographs here read 0.0006–0.0018, README "
+                    "\"Convergence\")",
                     [](auto& o) -> auto& { return o.stopping.settled_noise_reference; }));
   t.push_back(switch_flag("--no-remeshing", "global_remeshing", "Skip the global split/collapse before the flow",
                           [](auto& o) -> auto& { return o.global_remeshing; }, false));

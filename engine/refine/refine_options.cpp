@@ -25,6 +25,7 @@ void RefineOptions::check() const {
   check_member(untangling, "untangling");
   require_option(block_size >= 1, "block_size", block_size, ">= 1");
   require_option(image_levels >= 0 && image_levels <= 4, "image_levels", image_levels, "[0, 4]");
+  check_member(denoise, "denoise");
   check_member(silhouettes, "silhouettes");
   check_member(rims, "rims");
   require_option(visibility.half_patch == photo.photo.half_patch, "visibility.half_patch", visibility.half_patch,
@@ -57,6 +58,7 @@ RefineOptions thesis_preset() {
   options.rims.fit = RimFit::Off;
   options.unobserved_displacement.spread = UnobservedSpread::Off;
   options.photo.photo.surface_patch = SurfacePatchUse::Off;
+  options.denoise.use = DenoiseUse::Off;
   return options;
 }
 

@@ -8,6 +8,7 @@
 
 #include "stages/topology/adaptive_refinement.h"
 #include "stages/flow/curvature.h"
+#include "stages/flow/image_denoise.h"
 #include "stages/flow/photo_gradient.h"
 #include "stages/flow/regularization.h"
 #include "stages/topology/remeshing.h"
@@ -79,6 +80,10 @@ struct RefineOptions {
   //! refinement (with either schedule) waits for the full resolution; 0 = full resolution
   //! throughout (the thesis). 0..4.
   int image_levels = 0;
+  //! Noisy photographs blurred before the flow reads them, just enough to bring their estimated
+  //! noise to a reference (stages/flow/image_denoise.h); the settled rule then uses that
+  //! reference's tolerance. Auto by default, off in the thesis preset (README, "Noisy photographs").
+  DenoiseOptions denoise;
 
   RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration
   //! Folds removed where the flow has settled: before each coarse-to-fine refinement (then the

@@ -19,6 +19,7 @@
 #include "engine/model/parallel.h"
 #include "stages/topology/adaptive_refinement.h"
 #include "stages/flow/curvature.h"
+#include "stages/flow/image_denoise.h"
 #include "stages/flow/image_noise.h"
 #include "stages/flow/image_pyramid.h"
 #include "stages/flow/normals.h"
@@ -156,10 +157,10 @@ class Refinement {
     progress(0, RefineStage::Preparing);
     spreads_ = options.unobserved_displacement.spread != UnobservedSpread::Off;  // prepare() reads it
     const std::exception_ptr preparing_error = decode_while_preparing(scene);
-    views_ = full_views_;
+    views_ = flow_views();
     data_.on_block = control.on_block;
     for (int level = 0; level < options.image_levels; ++level)
-      levels_.push_back(half_resolution(level == 0 ? full_views_ : levels_.back()->views));
+      levels_.push_back(half_resolution(level == 0 ? flow_views() : levels_.back()->views));
     if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
     // Mask images, when the scene has them, stand for the thresholded photographs everywhere.
     rims_from_masks_ = scene.masks != nullptr;
@@ -202,15 +203,19 @@ class Refinement {
                             spreads_hardly_observed_ ? "hardly observed vertices" : "unobserved vertices",
                             data_.rim_masks ? " and the silhouette rims" : "");
     data_.reset_topology();  // the first iteration's Embree scene serves the initial evaluation too
-    summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, full_views_, *data_.surface, options_).sum_g_per_vertex;
+    summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, flow_views(), *data_.surface, options_).sum_g_per_vertex;
 
     StoppingOptions stopping_options = options_.stopping;
-    stopping_options.settled_tolerance = settled_tolerance_for_noise(options_.stopping, image_noise_);
+    stopping_options.settled_tolerance = settled_tolerance_for_noise(options_.stopping, flow_noise_);
     summary.image_noise = image_noise_;
+    summary.denoise_sigma = denoise_sigma_;
     summary.settled_tolerance = stopping_options.settled_tolerance;
+    if (control_.logger && denoised_)
+      control_.logger->info("image noise {:.4f} (median over the views): blurred with σ {:.2f} pixels to {:.4f}",
+                            image_noise_, denoise_sigma_, flow_noise_);
     if (control_.logger && stopping_options.settled_tolerance != options_.stopping.settled_tolerance)
-      control_.logger->info("image noise {:.4f} (median over the views): settled tolerance {:.4f} instead of {:.4f}",
-                            image_noise_, stopping_options.settled_tolerance, options_.stopping.settled_tolerance);
+      control_.logger->info("image noise {:.4f}: settled tolerance {:.4f} instead of {:.4f}", flow_noise_,
+                            stopping_options.settled_tolerance, options_.stopping.settled_tolerance);
     StoppingCriterion stopping(stopping_options);
     RefineStatus status = RefineStatus::MaxIterations;
     for (int iteration = 1;; ++iteration) {
@@ -272,7 +277,7 @@ class Refinement {
     const std::optional<UntanglingResult> untangled =
         status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
     summary.untangled_pairs = untangled_pairs_;
-    const SurfaceState final_state = evaluate_surface(mesh_, full_views_, SurfaceQuery(mesh_), options_);
+    const SurfaceState final_state = evaluate_surface(mesh_, flow_views(), SurfaceQuery(mesh_), options_);
     summary.status = status;
     summary.final_vertices = mesh_.n_vertices();
     summary.final_faces = mesh_.n_faces();
@@ -321,9 +326,18 @@ class Refinement {
     });
     if (decoding_error) std::rethrow_exception(decoding_error);
     pixel_size_ = finest_pixel_size(full_views_, centre);
-    // The photographs' noise sets the settled rule's tolerance (StoppingOptions::settled_noise_reference).
-    if (options_.stopping.settled_tolerance > 0 && options_.stopping.settled_noise_reference > 0)
-      image_noise_ = estimate_views_noise(full_views_);
+    // The photographs' noise decides their blur (DenoiseOptions) and sets the settled rule's
+    // tolerance (StoppingOptions::settled_noise_reference) from what the blur leaves of it.
+    const bool settles_by_noise = options_.stopping.settled_tolerance > 0 && options_.stopping.settled_noise_reference > 0;
+    if (settles_by_noise || options_.denoise.use == DenoiseUse::Auto) image_noise_ = estimate_views_noise(full_views_);
+    flow_noise_ = image_noise_;
+    if (options_.denoise.use == DenoiseUse::Auto && image_noise_ > options_.denoise.noise_reference) {
+      denoise_sigma_ = denoise_sigma_for(image_noise_, options_.denoise.noise_reference);
+      denoised_ = blurred_views(full_views_, denoise_sigma_);
+      // At most the reference: the bisection's σ leaves no more, and rounding must not lift it above.
+      flow_noise_ = std::min(image_noise_ * gaussian_noise_gain(denoise_sigma_), options_.denoise.noise_reference);
+    }
+    if (!settles_by_noise) flow_noise_ = 0.0;
     return preparing_error;
   }
 
@@ -451,7 +465,7 @@ class Refinement {
       return false;
     if (!levels_.empty()) {  // settled on these images: the next finer ones before any refinement
       levels_.pop_back();
-      views_ = levels_.empty() ? full_views_ : levels_.back()->views;
+      views_ = levels_.empty() ? flow_views() : levels_.back()->views;
       data_.step_scale = 1.0;  // Σg/vertex on other images says nothing about the steps on these
       data_.previous_g_per_vertex = 0.0;
       data_.damping.reset(mesh_.n_vertices());  // reversals on other images say nothing about these
@@ -521,7 +535,12 @@ class Refinement {
   const RefineOptions& options_;
   const RefineControl& control_;
   std::size_t initial_vertices_ = 0, initial_faces_ = 0;  //!< of the mesh given
-  std::vector<PhotoView> full_views_;  //!< the photographs the refinement may use
+  std::vector<PhotoView> full_views_;  //!< the photographs the refinement may use, as given
+  //! Their blurred copies when they are noisy (DenoiseOptions), else null.
+  std::unique_ptr<ImageLevel> denoised_;
+  //! The full-resolution views the photo consistency reads: the blurred ones when there are, else
+  //! the photographs as given (the silhouettes always threshold those).
+  const std::vector<PhotoView>& flow_views() const { return denoised_ ? denoised_->views : full_views_; }
   std::vector<std::unique_ptr<ImageLevel>> levels_;  //!< halved once, twice, ...; dropped as the flow gets there
   std::vector<PhotoView> views_;       //!< the views the iterations read now (a level's or the full ones)
   TriMesh mesh_;
@@ -534,6 +553,8 @@ class Refinement {
   //! (UnobservedDisplacementOptions::spread_unmoved).
   bool spreads_unmoved_ = false;
   double image_noise_ = 0.0;  //!< estimate_views_noise of the photographs (0 when not needed)
+  double denoise_sigma_ = 0.0;  //!< the blur of denoised_ in pixels (0: none)
+  double flow_noise_ = 0.0;     //!< the noise the flow's photographs keep (0 when the settled rule ignores it)
   int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the hardly observed (the spread is auto without rims: spread_fraction()).

@@ -169,6 +169,7 @@ py::dict summary_dict(const RefineSummary& summary) {
   d["initial_sum_g_per_vertex"] = summary.initial_sum_g_per_vertex;
   d["final_sum_g_per_vertex"] = summary.final_sum_g_per_vertex;
   d["image_noise"] = summary.image_noise;
+  d["denoise_sigma"] = summary.denoise_sigma;
   d["settled_tolerance"] = summary.settled_tolerance;
   d["self_intersections"] = summary.self_intersections;
   d["seconds"] = summary.seconds;
