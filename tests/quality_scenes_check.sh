@@ -3,7 +3,8 @@
 # and with the south cap's error computed here, independently, from an OBJ copy of the refined
 # mesh, its surface-patch share with the report's counts, and its item-5 verdict with the line's
 # own figures; --compare of a run with itself must give 1.000 and identical meshes, with a shorter
-# run its ratio and none; an unknown scene name is refused before any work, and a refinement that
+# run its ratio and none, of two runs against one the ratio of their means; --spread must run
+# the options again with the velocity moved by ±1e-4 relative; an unknown scene name is refused before any work, and a refinement that
 # fails makes it exit 1.
 #   tests/quality_scenes_check.sh MVFLOW SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -17,6 +18,14 @@ MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" --compare a a > "$wo
 # A run that differs (stopped after 12 iterations): its ratio is not 1 and its mesh not identical.
 MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" short --scenes grazing -- --max-iterations 12 > /dev/null
 MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" --compare a short > "$work/compare_short.txt"
+# Means of several runs per side: (a + short) / 2 against a.
+MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" --compare a,short a > "$work/compare_means.txt"
+# --spread: the same options twice more with the velocity moved by ±1e-4 relative (the default's, 0.001).
+MVFLOW=$mvflow bash "$root/tools/quality_scenes.sh" "$work" e --scenes grazing --spread -- --max-iterations 12 > /dev/null
+grep -qx -- "--max-iterations 12 --velocity 0.0010001" "$work/runs/e.vp/options.txt"
+grep -qx -- "--max-iterations 12 --velocity 0.0009999" "$work/runs/e.vm/options.txt"
+grep -q "^grazing  mean" "$work/runs/e.vm/summary.txt"
+! cmp -s "$work/runs/e/grazing.ply" "$work/runs/e.vp/grazing.ply"  # the velocity reached the run
 "$mvflow" --log-level warn convert "$work/runs/a/grazing.ply" "$work/grazing.obj"
 python3 - "$work" <<'PY'
 import json, math, re, sys
@@ -67,6 +76,9 @@ short = float(re.search(r'mean (\S+)', open(f'{work}/runs/short/summary.txt').re
 ratio = f"{short / mean:.3f}"
 compare = open(f'{work}/compare_short.txt').read()
 assert ratio != "1.000" and f"{short:.5f}  {ratio}" in compare and "identical meshes: 0 of 1" in compare, compare
+compare = open(f'{work}/compare_means.txt').read()
+assert "means of 2 runs against means of 1 runs" in compare and "identical meshes" not in compare, compare
+assert f"{(mean + short) / 2:.5f} -> {mean:.5f}  {mean / ((mean + short) / 2):.3f}" in compare, compare
 print('quality_scenes.sh agrees with mvflow eval and with the cap computed from the OBJ:', line.strip())
 PY
 # Twelve iterations leave the mean error far above item 5's 0.0025: the verdict names it.

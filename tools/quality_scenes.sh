@@ -3,8 +3,8 @@
 # refines each with the given options, scores it against its ground truth with `mvflow eval`,
 # and, on the unit spheres, the error of the weakly seen south cap against the rest (issue 12).
 #
-#   bash tools/quality_scenes.sh OUT TAG [--scenes "a b ..."] [--band-degrees D] [-- REFINE OPTIONS...]
-#   bash tools/quality_scenes.sh OUT --compare TAG_A TAG_B
+#   bash tools/quality_scenes.sh OUT TAG [--scenes "a b ..."] [--band-degrees D] [--spread] [-- REFINE OPTIONS...]
+#   bash tools/quality_scenes.sh OUT --compare TAG_A[,TAG_A2...] TAG_B[,TAG_B2...]
 #
 # Scenes (README "Quality", "Weakly seen regions"): bumpy, peanut, bunny (the three quality
 # scenes, tuned on); grazing and peer (the unit-sphere rigs of issue 12); t1–t5 and v1–v5 (rendered
@@ -28,16 +28,20 @@
 # for byte the same: a change meant to keep the results, e.g. for speed, must show 15 of 15)
 # and their geometric mean: a default
 # should win on several scenes by more than the arithmetic-order spread (README "Quality": e.g.
-# the peanut 0.00479–0.00529 for one and the same code).
+# the peanut 0.00479–0.00529 for one and the same code). --spread runs each scene twice more, as
+# TAG.vp and TAG.vm, with the balloon velocity (the one given, else the default) times 1.0001 and
+# 0.9999: a change that moves no vertex measurably in one iteration, which shows the yardstick's
+# own spread (README "Quality": up to 37 % on a peanut). --compare with comma-separated tags
+# compares, per scene, the mean of each side's runs, e.g. --compare A,A.vp,A.vm B,B.vp,B.vm.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 mvflow=${MVFLOW:-$root/build/tools/mvflow}  # MVFLOW: another build
-usage() { echo "usage: $0 OUT TAG [--scenes \"a b ...\"] [--band-degrees D] [-- REFINE OPTIONS...] | $0 OUT --compare TAG_A TAG_B" >&2; exit 2; }
+usage() { echo "usage: $0 OUT TAG [--scenes \"a b ...\"] [--band-degrees D] [--spread] [-- REFINE OPTIONS...] | $0 OUT --compare TAG_A[,...] TAG_B[,...]" >&2; exit 2; }
 [ $# -ge 2 ] || usage
 out=$1
 shift
 
-summarise() {  # summarise RUNS_A RUNS_B
+summarise() {  # summarise RUNS_A[,RUNS_A2...] RUNS_B[,...] (run folders, comma-separated)
   python3 - "$1" "$2" <<'EOF'
 import filecmp, math, os, sys
 def read(path):
@@ -47,21 +51,28 @@ def read(path):
         if len(f) > 3 and f[1] == 'mean':
             rows[f[0]] = float(f[2])
     return rows
-runs_a, runs_b = sys.argv[1], sys.argv[2]
-a, b = read(runs_a + '/summary.txt'), read(runs_b + '/summary.txt')
+side_a, side_b = sys.argv[1].split(','), sys.argv[2].split(',')
+a_runs, b_runs = [read(r + '/summary.txt') for r in side_a], [read(r + '/summary.txt') for r in side_b]
+single = len(side_a) == 1 and len(side_b) == 1
+if not single:
+    print(f"means of {len(side_a)} runs against means of {len(side_b)} runs")
 logs, identical = [], 0
-for name in a:
-    if name in b and a[name] > 0 and b[name] > 0:
-        logs.append(math.log(b[name] / a[name]))
-        same = filecmp.cmp(f'{runs_a}/{name}.ply', f'{runs_b}/{name}.ply', shallow=False)
+names = [n for n in a_runs[0] if all(n in r for r in a_runs + b_runs)]
+for name in names:
+    a = sum(r[name] for r in a_runs) / len(a_runs)
+    b = sum(r[name] for r in b_runs) / len(b_runs)
+    if a > 0 and b > 0:
+        logs.append(math.log(b / a))
+        same = single and filecmp.cmp(f'{side_a[0]}/{name}.ply', f'{side_b[0]}/{name}.ply', shallow=False)
         identical += same
-        print(f"{name:8s} {a[name]:.5f} -> {b[name]:.5f}  {b[name] / a[name]:.3f}{'  (identical mesh)' if same else ''}")
+        print(f"{name:8s} {a:.5f} -> {b:.5f}  {b / a:.3f}{'  (identical mesh)' if same else ''}")
 if not logs:
     sys.exit("no scene in common")
-print(f"identical meshes: {identical} of {len(logs)}")
-missing = sorted(set(a) ^ set(b))
+if single:
+    print(f"identical meshes: {identical} of {len(logs)}")
+missing = sorted(set().union(*a_runs, *b_runs) - set(names))
 if missing:
-    print("scored in only one of the runs (failed or not run in the other): " + ' '.join(missing))
+    print("scored in only some of the runs (failed or not run in the others): " + ' '.join(missing))
 wins = sum(l < math.log(0.97) for l in logs); losses = sum(l > math.log(1.03) for l in logs)
 print(f"geometric mean {math.exp(sum(logs) / len(logs)):.3f} over {len(logs)} scenes; "
       f"better by > 3 % on {wins}, worse by > 3 % on {losses}")
@@ -70,10 +81,17 @@ EOF
 
 if [ "$1" = --compare ]; then
   [ $# -eq 3 ] || usage
-  for tag in "$2" "$3"; do
-    [ -f "$out/runs/$tag/summary.txt" ] || { echo "$0: $out/runs/$tag/summary.txt is missing" >&2; exit 1; }
+  sides=()
+  for list in "$2" "$3"; do
+    folders=""
+    IFS=, read -ra tags <<< "$list"
+    for tag in "${tags[@]}"; do
+      [ -f "$out/runs/$tag/summary.txt" ] || { echo "$0: $out/runs/$tag/summary.txt is missing" >&2; exit 1; }
+      folders+="${folders:+,}$out/runs/$tag"
+    done
+    sides+=("$folders")
   done
-  summarise "$out/runs/$2" "$out/runs/$3"
+  summarise "${sides[0]}" "${sides[1]}"
   exit 0
 fi
 
@@ -100,9 +118,11 @@ expand_groups() {  # the scene names of $1, its groups expanded
 }
 scenes=$main
 band_degrees=20
+spread=0
 while [ $# -gt 0 ]; do
   case $1 in
     --scenes) [ $# -ge 2 ] || usage; scenes=$(expand_groups "$2"); shift 2 ;;
+    --spread) spread=1; shift ;;
     --band-degrees) [ $# -ge 2 ] || usage; band_degrees=$2; shift 2
       [[ "$band_degrees" =~ ^[1-9][0-9]*$ ]] && ((180 % band_degrees == 0)) ||
         { echo "$0: --band-degrees must be a whole number dividing 180, got '$band_degrees'" >&2; exit 2; } ;;
@@ -164,32 +184,36 @@ for name in $scenes; do
   synth_options "$name" || { echo "$0: unknown scene '$name' (known: bumpy peanut bunny grazing peer t1-t5 v1-v5 u1-u8 b1-b3 w1-w6 l1-l8, groups main spheres bumpy-family weak held-out all low)" >&2; exit 2; }
 done
 
-runs=$out/runs/$tag
-mkdir -p "$out/scenes" "$runs"
+mkdir -p "$out/scenes"
 failed=0
-: > "$runs/summary.txt"
-printf '%s\n' "${refine_options[*]:-(defaults)}" > "$runs/options.txt"
-for name in $scenes; do
-  scene=$out/scenes/$name
-  if [ ! -f "$scene/synth.json" ]; then  # synth writes it last: a scene cut short is rendered again
-    synth_options "$name"
-    "$mvflow" --log-level warn synth "${synth_args[@]}" -o "$scene" > "$scene.log" 2>&1 ||
-      { echo "$0: rendering $name failed (log: $scene.log)" >&2; tail -3 "$scene.log" >&2; exit 1; }
-  fi
-  run=$runs/$name
-  if ! "$mvflow" --log-level warn refine "$scene" -o "$run.ply" --report "$run.json" "${refine_options[@]}" > "$run.log" 2>&1; then
-    echo "$name refine FAILED (log: $run.log)" | tee -a "$runs/summary.txt"
-    failed=$((failed + 1))
-    continue
-  fi
-  if ! "$mvflow" --log-level warn eval "$run.ply" "$scene/truth.ply" --samples 50000 --json "$run.eval.json" > "$run.eval.log" 2>&1; then
-    echo "$name eval FAILED (log: $run.eval.log)" | tee -a "$runs/summary.txt"
-    failed=$((failed + 1))
-    continue
-  fi
-  cap_side=0  # the unit spheres: −1 the south cap is the weakly seen one, +1 the north
-  case $name in grazing | peer | t3 | u1 | u2 | u3 | u5 | u6 | u8) cap_side=-1 ;; v5 | u4 | u7) cap_side=1 ;; esac
-  python3 - "$name" "$run" "$cap_side" "$band_degrees" <<'EOF' | tee -a "$runs/summary.txt"
+run_tag() {  # run_tag TAG REFINE OPTIONS...: every scene refined with the options into runs/TAG
+  local runs=$out/runs/$1 name scene run cap_side
+  shift
+  local options=("$@")
+  mkdir -p "$runs"
+  : > "$runs/summary.txt"
+  printf '%s\n' "${options[*]:-(defaults)}" > "$runs/options.txt"
+  for name in $scenes; do
+    scene=$out/scenes/$name
+    if [ ! -f "$scene/synth.json" ]; then  # synth writes it last: a scene cut short is rendered again
+      synth_options "$name"
+      "$mvflow" --log-level warn synth "${synth_args[@]}" -o "$scene" > "$scene.log" 2>&1 ||
+        { echo "$0: rendering $name failed (log: $scene.log)" >&2; tail -3 "$scene.log" >&2; exit 1; }
+    fi
+    run=$runs/$name
+    if ! "$mvflow" --log-level warn refine "$scene" -o "$run.ply" --report "$run.json" "${options[@]}" > "$run.log" 2>&1; then
+      echo "$name refine FAILED (log: $run.log)" | tee -a "$runs/summary.txt"
+      failed=$((failed + 1))
+      continue
+    fi
+    if ! "$mvflow" --log-level warn eval "$run.ply" "$scene/truth.ply" --samples 50000 --json "$run.eval.json" > "$run.eval.log" 2>&1; then
+      echo "$name eval FAILED (log: $run.eval.log)" | tee -a "$runs/summary.txt"
+      failed=$((failed + 1))
+      continue
+    fi
+    cap_side=0  # the unit spheres: −1 the south cap is the weakly seen one, +1 the north
+    case $name in grazing | peer | t3 | u1 | u2 | u3 | u5 | u6 | u8) cap_side=-1 ;; v5 | u4 | u7) cap_side=1 ;; esac
+    python3 - "$name" "$run" "$cap_side" "$band_degrees" <<'EOF' | tee -a "$runs/summary.txt"
 import json, math, struct, sys
 name, run, cap_side, band_degrees = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
 e = json.load(open(run + '.eval.json')); r = json.load(open(run + '.json'))
@@ -232,7 +256,24 @@ elif cap_side:
     line += ' | item 5 ' + ('met' if not missed else 'missed: ' + ', '.join(missed))
 print(line)
 EOF
-done
+  done
+}
+run_tag "$tag" "${refine_options[@]}"
+if [ "$spread" = 1 ]; then
+  # The balloon velocity given (its last --velocity), else the default --help shows.
+  velocity=$("$mvflow" refine --help | sed -n 's/.*--velocity FLOAT=\([^ ]*\).*/\1/p')
+  others=()
+  for ((i = 0; i < ${#refine_options[@]}; i++)); do
+    case ${refine_options[i]} in
+      --velocity) velocity=${refine_options[i + 1]}; i=$((i + 1)) ;;
+      --velocity=*) velocity=${refine_options[i]#--velocity=} ;;
+      *) others+=("${refine_options[i]}") ;;
+    esac
+  done
+  for factor in vp:1.0001 vm:0.9999; do
+    run_tag "$tag.${factor%%:*}" "${others[@]}" --velocity "$(python3 -c "print('%.10g' % ($velocity * ${factor#*:}))")"
+  done
+fi
 if [ "$failed" -gt 0 ]; then
   echo "$0: $failed scene(s) failed (their logs are named above)" >&2
   exit 1
