@@ -15,6 +15,8 @@
 #include "engine/model/error.h"
 #include "engine/refine/refiner.h"
 #include "stages/eval/evaluation.h"
+#include "stages/flow/image_noise.h"
+#include "stages/flow/photo_views.h"
 #include "stages/synth/synth_scene.h"
 
 namespace mvflow {
@@ -105,6 +107,9 @@ std::vector<RefineOptions> determinism_cases() {
   photograph_rules.photo.photo.drop_views = 1;
   photograph_rules.photo.photo.min_views = 3;
   photograph_rules.visibility.max_views = 5;
+  // ... and the blur of noisy photographs: this clean render counts as noisy against a reference
+  // of half its estimated noise (σ ≈ 0.55 pixels), so each view's blurred copy is made and read.
+  photograph_rules.denoise.noise_reference = 0.5 * estimate_views_noise(make_photo_views(small_scene().scene));
   return {by_default, thesis_rules, optional_rules, photograph_rules};
 }
 
@@ -127,6 +132,7 @@ void expect_same_bits(const RefineOptions& options) {
   sequential.engine = EngineKind::Sequential;
   const RefineResult plain = refine_mesh(s.scene, s.initial, sequential, two);
 
+  if (options.denoise.noise_reference < 0.001) EXPECT_GT(reference.summary.denoise_sigma, 0.0);
   for (const RefineResult* other : {&single, &blocks, &plain}) {
     ASSERT_EQ(other->summary.iterations.size(), reference.summary.iterations.size());
     EXPECT_EQ(positions(*other), positions(reference));  // exact, not approximate
