@@ -82,7 +82,7 @@ struct RefineOptions {
   int image_levels = 0;
   //! Noisy photographs blurred before the flow reads them, just enough to bring their estimated
   //! noise to a reference (stages/flow/image_denoise.h); the settled rule then uses that
-  //! reference's tolerance. Auto by default, off in the thesis preset (README, "Noisy photographs").
+  //! reference's tolerance. Auto by default, off in the thesis preset (README, "Convergence").
   DenoiseOptions denoise;
 
   RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration
