@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "engine/model/image.h"
@@ -174,6 +175,27 @@ TEST(ImageDenoise, AnImpulseBecomesTheKernelAndAConstantStays) {
   // A constant stays constant up to the border (the border pixel repeats).
   const Image flat = gaussian_blur(Image(9, 7, std::vector<float>(9 * 7 * 3, 0.25f)), 2.0);
   for (std::size_t i = 0; i < 9 * 7 * 3; ++i) EXPECT_NEAR(flat.data()[i], 0.25f, 1e-7);
+  // Any image against the 2-D convolution written out here, the border pixel repeated: images
+  // taller and shorter than the kernel (the blur keeps only 2R + 1 blurred rows at a time).
+  for (const auto& [w, h, s] : {std::tuple{13, 17, 0.9}, std::tuple{8, 3, 1.6}}) {
+    std::mt19937 random(static_cast<unsigned>(w * h));
+    std::uniform_real_distribution<float> value(0.0f, 1.0f);
+    std::vector<float> pixels(static_cast<std::size_t>(w) * h * 3);
+    for (float& p : pixels) p = value(random);
+    const Image result = gaussian_blur(Image(w, h, pixels), s);
+    const std::vector<double> t = reference_taps(s);
+    const int r = static_cast<int>(t.size() / 2);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 3; ++c) {
+          double expected = 0.0;
+          for (int j = -r; j <= r; ++j)
+            for (int i = -r; i <= r; ++i)
+              expected += t[i + r] * t[j + r] *
+                          pixels[(static_cast<std::size_t>(std::clamp(y + j, 0, h - 1)) * w + std::clamp(x + i, 0, w - 1)) * 3 + c];
+          EXPECT_NEAR(result.data()[(static_cast<std::size_t>(y) * w + x) * 3 + c], expected, 1e-6) << w << "x" << h << " " << x << ", " << y;
+        }
+  }
   // σ ≤ 0: the image as given.
   const Image same = gaussian_blur(blurred, 0.0);
   EXPECT_TRUE(std::equal(same.data(), same.data() + size * size * 3, blurred.data()));

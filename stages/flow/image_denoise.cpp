@@ -53,35 +53,41 @@ double denoise_sigma_for(double noise, double reference) {
 Image gaussian_blur(const Image& image, double sigma) {
   if (!(sigma > 0.0) || image.empty()) return image;
   const std::vector<double> taps = gaussian_taps(sigma);
-  const int radius = static_cast<int>(taps.size() / 2);
+  const auto radius = static_cast<std::ptrdiff_t>(taps.size() / 2);
   const std::size_t width = static_cast<std::size_t>(image.width()), height = static_cast<std::size_t>(image.height());
   const std::size_t row_values = width * 3;
-  // Rows into a double buffer (each row padded with its border pixels), then columns back to
-  // float, whole rows at a time: one rounding per value, the taps summed in one fixed order.
-  std::vector<double> rows(row_values * height);
+  const auto clamp_row = [&](std::ptrdiff_t y) {
+    return static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(y, 0, static_cast<std::ptrdiff_t>(height) - 1));
+  };
+  // Rows blurred into doubles (each row padded with its border pixels), then columns back to
+  // float, whole rows at a time: one rounding per value, the taps summed in one fixed order. Only
+  // the 2R + 1 blurred rows a column sum reads are kept, in a ring: a 24-megapixel photograph
+  // would need 576 MB of doubles at once.
+  std::vector<double> ring(taps.size() * row_values);
   std::vector<double> padded((width + 2 * static_cast<std::size_t>(radius)) * 3);
-  for (std::size_t y = 0; y < height; ++y) {
+  const auto blur_row = [&](std::size_t y) {
     const float* source = image.data() + y * row_values;
     for (std::size_t x = 0; x < padded.size() / 3; ++x) {
       const std::size_t from = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(
           static_cast<std::ptrdiff_t>(x) - radius, 0, static_cast<std::ptrdiff_t>(width) - 1));
       for (std::size_t c = 0; c < 3; ++c) padded[x * 3 + c] = source[from * 3 + c];
     }
-    double* row = rows.data() + y * row_values;
+    double* row = ring.data() + (y % taps.size()) * row_values;
     for (std::size_t i = 0; i < row_values; ++i) {
       double sum = 0.0;
       for (std::size_t k = 0; k < taps.size(); ++k) sum += taps[k] * padded[i + k * 3];
       row[i] = sum;
     }
-  }
+  };
   Image blurred = Image::uninitialized(image.width(), image.height());  // every value written below
   std::vector<double> sum(row_values);
+  std::size_t blurred_rows = 0;  // rows 0 .. blurred_rows − 1 have been blurred (the last 2R + 1 are in the ring)
   for (std::size_t y = 0; y < height; ++y) {
+    for (const std::size_t last = clamp_row(static_cast<std::ptrdiff_t>(y) + radius); blurred_rows <= last; ++blurred_rows)
+      blur_row(blurred_rows);
     std::fill(sum.begin(), sum.end(), 0.0);
     for (std::size_t k = 0; k < taps.size(); ++k) {
-      const std::size_t from = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(
-          static_cast<std::ptrdiff_t>(y + k) - radius, 0, static_cast<std::ptrdiff_t>(height) - 1));
-      const double* row = rows.data() + from * row_values;
+      const double* row = ring.data() + (clamp_row(static_cast<std::ptrdiff_t>(y + k) - radius) % taps.size()) * row_values;
       for (std::size_t i = 0; i < row_values; ++i) sum[i] += taps[k] * row[i];
     }
     float* target = blurred.data() + y * row_values;
