@@ -132,7 +132,9 @@ void expect_same_bits(const RefineOptions& options) {
   sequential.engine = EngineKind::Sequential;
   const RefineResult plain = refine_mesh(s.scene, s.initial, sequential, two);
 
-  if (options.denoise.noise_reference < 0.001) EXPECT_GT(reference.summary.denoise_sigma, 0.0);
+  if (options.denoise.noise_reference < 0.001) {
+    EXPECT_GT(reference.summary.denoise_sigma, 0.0);
+  }
   for (const RefineResult* other : {&single, &blocks, &plain}) {
     ASSERT_EQ(other->summary.iterations.size(), reference.summary.iterations.size());
     EXPECT_EQ(positions(*other), positions(reference));  // exact, not approximate

@@ -113,11 +113,11 @@ TEST(Quality, Bunny) {
 }
 
 // Image noise (σ = 0.01 per channel on a two-ring sphere, issue 12's t3 scene): by default the
-// photographs are blurred just enough to bring their estimated noise to the reference 0.002
-// (stages/flow/image_denoise.h), so the settled rule keeps its tolerance; with `--denoise off` the
-// noise raises the tolerance by √(σ̂/0.002) instead (sessions 23–25), and with that rule off too
-// the run takes longest. Measured (session 26): 42 iterations, mean 0.00142, against 58 and
-// 0.00150 with --denoise off and 74 and 0.00151 with both off.
+// photographs are blurred just enough to bring their estimated noise to the reference 0.002 for
+// the image patches (stages/flow/image_denoise.h), so the settled rule keeps its tolerance; with
+// `--denoise off` the noise raises the tolerance by √(σ̂/0.002) instead (sessions 23–25), and with
+// that rule off too the run takes longest. Measured (session 26): 50 iterations, mean 0.00142,
+// against 58 and 0.00150 with --denoise off and 74 and 0.00151 with both off.
 TEST(Quality, NoisyPhotographsAreBlurredAndSettleSooner) {
   const test::ScratchFolder dir;
   const auto scene = dir.path() / "scene";

@@ -18,6 +18,7 @@
 
 #include "engine/model/primitives.h"
 #include "engine/model/surface_query.h"
+#include "stages/flow/image_denoise.h"
 #include "stages/flow/normals.h"
 #include "stages/flow/photo_consistency.h"
 #include "stages/flow/photo_gradient.h"
@@ -1183,6 +1184,48 @@ TEST(SurfacePatch, TheGradientStageRecordsEachVertexsKindAndItsSwitches) {
          "vertices 0 and 1 with the 65° view");
   fields.resize(mesh.n_vertices(), scene.views.size());  // a new topology
   EXPECT_EQ(fields.patch_kind[1], PatchKind::Undecided);
+}
+
+// The refinement's blurred copies serve the whole-pixel image patches only (DenoiseOptions): with
+// other photographs given for the surface patches, a vertex that lays its patch on the surface
+// gets exactly what it gets when every view is those photographs, and a vertex with an image
+// patch exactly what it gets without them; likewise g alone (compute_photo_consistency).
+TEST(SurfacePatch, SurfacePatchesReadTheirOwnPhotographs) {
+  const PlaneScene scene = oblique_plane_scene();  // views at 0°, 35°, 60° and 65° from the normal
+  const auto blurred = blurred_views(scene.views, 1.2);
+  Mesh mesh;
+  for (double x = -6; x <= 6; x += 3) mesh.topology.add_vertex(to_openmesh(Eigen::Vector3d(x, 0.4 * x, 0.5)));
+  const auto odd = [](std::size_t v) { return v % 2 == 1; };  // with the 65° view: a surface patch
+  const auto run = [&](const std::vector<PhotoView>& views, const std::vector<PhotoView>* surface_views) {
+    VertexFields fields;
+    fields.resize(mesh.n_vertices(), scene.views.size());
+    for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+      fields.normal[v] = Eigen::Vector3d::UnitZ();
+      fields.visible_count[v] = odd(v) ? 4 : 2;
+      std::copy(scene.all.begin(), scene.all.end(), fields.visible_views.begin() + v * fields.view_capacity);
+    }
+    const IndexRange all{0, static_cast<std::uint32_t>(mesh.n_vertices())};
+    const PhotoGradientStage stage{PhotoGradientOptions{}};  // Oblique at 60°
+    stage.run(mesh.topology, all, views, stage.sample_spacing(4.0), fields, surface_views);
+    VertexFields g_only = fields;
+    compute_photo_consistency(mesh.topology, all, views, PhotoConsistencyOptions{}, g_only, surface_views);
+    return std::pair{fields, g_only};
+  };
+  const auto [mixed, mixed_g] = run(blurred->views, &scene.views);  // image patches blurred, surface ones not
+  const auto [given, given_g] = run(scene.views, nullptr);
+  const auto [all_blurred, all_blurred_g] = run(blurred->views, nullptr);
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) {
+    ASSERT_TRUE(mixed.defined[v] & kGradientDefined) << v;
+    EXPECT_EQ(mixed.patch_kind[v], odd(v) ? PatchKind::Surface : PatchKind::Image) << v;
+    const VertexFields& expected = odd(v) ? given : all_blurred;
+    const VertexFields& expected_g = odd(v) ? given_g : all_blurred_g;
+    EXPECT_EQ(mixed.photo_consistency[v], expected.photo_consistency[v]) << v;
+    EXPECT_EQ(mixed.photo_gradient[v], expected.photo_gradient[v]) << v;
+    EXPECT_EQ(mixed_g.photo_consistency[v], expected_g.photo_consistency[v]) << v;
+    // ... and the blur changed the value, so the test tells the two apart.
+    const VertexFields& other = odd(v) ? all_blurred : given;
+    EXPECT_NE(mixed.photo_consistency[v], other.photo_consistency[v]) << v;
+  }
 }
 
 }  // namespace

@@ -164,7 +164,8 @@ std::vector<RefineOptionEntry> make_table() {
                     [](auto& o) -> auto& { return o.image_levels; }));
   t.push_back(choice("--denoise", "denoise",
                      "Photographs whose estimated noise is above --denoise-reference are blurred (Gaussian) just "
-                     "enough to bring it there before the flow reads them: auto or off (thesis preset: off)",
+                     "enough to bring it there for the whole-pixel image patches (surface patches read them as "
+                     "given; with --surface-patch on nothing is blurred): auto or off (thesis preset: off)",
                      {{"auto", DenoiseUse::Auto}, {"off", DenoiseUse::Off}}, [](auto& o) -> auto& { return o.denoise.use; }));
   t.push_back(value("--denoise-reference", "denoise_noise_reference", "denoise.noise_reference",
                     "--denoise auto: the noise σ (on [0, 1]) the photographs are blurred down to",

@@ -130,10 +130,10 @@ void IterationData::photo_speed(std::size_t block) {
       const IndexRange range = blocks[block];
       parallel::parallel_for(oneapi::tbb::blocked_range<std::uint32_t>(range.begin, range.end, kPhotoGrain),
                              [&](const oneapi::tbb::blocked_range<std::uint32_t>& part) {
-                               photo.run(mesh, {part.begin(), part.end()}, views, sample_spacing, fields);
+                               photo.run(mesh, {part.begin(), part.end()}, views, sample_spacing, fields, surface_views);
                              });
     } else {
-      photo.run(mesh, blocks[block], views, sample_spacing, fields);
+      photo.run(mesh, blocks[block], views, sample_spacing, fields, surface_views);
     }
     compute_speed(blocks[block], options.speed, fields);
     partials[block] = reduce_block(blocks[block], fields);

@@ -47,6 +47,9 @@ struct IterationData {
   //! fit_rims phase reads them; otherwise null.
   const std::vector<Mask>* rim_masks = nullptr;
   const std::vector<PhotoView>* rim_views = nullptr;  //!< the full-resolution views of rim_masks
+  //! The photographs the surface patches read when they differ from `views` (the photographs as
+  //! given while `views` are their blurred copies, DenoiseOptions); null: `views`.
+  const std::vector<PhotoView>* surface_views = nullptr;
   //! One flag per vertex: it made a view's outline in the last iteration (only when the rims are
   //! fitted; the silhouettes observe it, so the unobserved spread leaves it where it is).
   std::vector<std::uint8_t> on_rim;

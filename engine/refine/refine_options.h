@@ -80,9 +80,11 @@ struct RefineOptions {
   //! refinement (with either schedule) waits for the full resolution; 0 = full resolution
   //! throughout (the thesis). 0..4.
   int image_levels = 0;
-  //! Noisy photographs blurred before the flow reads them, just enough to bring their estimated
-  //! noise to a reference (stages/flow/image_denoise.h); the settled rule then uses that
-  //! reference's tolerance. Auto by default, off in the thesis preset (README, "Convergence").
+  //! Noisy photographs blurred before the whole-pixel image patches read them, just enough to
+  //! bring their estimated noise to a reference (stages/flow/image_denoise.h); the surface patches
+  //! read them as given (a blur in the image smears an oblique view along the surface), and with
+  //! surface patches everywhere nothing is blurred. The settled rule then uses the reference's
+  //! tolerance. Auto by default, off in the thesis preset (README, "Convergence").
   DenoiseOptions denoise;
 
   RefinementSchedule refinement_schedule = RefinementSchedule::AtConvergence;  //!< thesis: EveryIteration

@@ -98,8 +98,11 @@ struct SurfaceState {
   double sum_g_per_vertex = 0.0;
 };
 
-// \p surface: Embree's scene of \p mesh as it is now.
-SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>& views, const SurfaceQuery& surface,
+// \p surface: Embree's scene of \p mesh as it is now. Image patches read \p views, surface patches
+// and the colours \p photographs (the same cameras: the photographs as given, whose blurred copies
+// \p views may be, DenoiseOptions).
+SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>& views,
+                              const std::vector<PhotoView>& photographs, const SurfaceQuery& surface,
                               const RefineOptions& options) {
   VertexFields fields;
   fields.resize(mesh.n_vertices(), views.size());
@@ -114,12 +117,12 @@ SurfaceState evaluate_surface(const TriMesh& mesh, const std::vector<PhotoView>&
     compute_normals(mesh, block, fields);
     compute_visibility(mesh, block, views, surface, mean_edge, options.visibility, fields);
     drop_outlier_views(mesh, block, views, options.photo.photo, fields);
-    compute_photo_consistency(mesh, block, views, options.photo.photo, fields);
+    compute_photo_consistency(mesh, block, views, options.photo.photo, fields, &photographs);
     for (std::uint32_t v = block.begin; v < block.end; ++v) {
       const Eigen::Vector3d P = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
       Eigen::Vector3d colour = Eigen::Vector3d::Zero();
       for (const std::uint16_t id : fields.visible(v)) {
-        const PhotoView& view = views[id];
+        const PhotoView& view = photographs[id];
         const Projection p = view.project(P);
         colour += view.image->sample_bilinear(p.u, p.v).cast<double>();
       }
@@ -162,6 +165,7 @@ class Refinement {
     for (int level = 0; level < options.image_levels; ++level)
       levels_.push_back(half_resolution(level == 0 ? flow_views() : levels_.back()->views));
     if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
+    data_.surface_views = surface_views();
     // Mask images, when the scene has them, stand for the thresholded photographs everywhere.
     rims_from_masks_ = scene.masks != nullptr;
     const std::vector<Mask> given =
@@ -203,7 +207,7 @@ class Refinement {
                             spreads_hardly_observed_ ? "hardly observed vertices" : "unobserved vertices",
                             data_.rim_masks ? " and the silhouette rims" : "");
     data_.reset_topology();  // the first iteration's Embree scene serves the initial evaluation too
-    summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, flow_views(), *data_.surface, options_).sum_g_per_vertex;
+    summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, flow_views(), full_views_, *data_.surface, options_).sum_g_per_vertex;
 
     StoppingOptions stopping_options = options_.stopping;
     stopping_options.settled_tolerance = settled_tolerance_for_noise(options_.stopping, flow_noise_);
@@ -277,7 +281,7 @@ class Refinement {
     const std::optional<UntanglingResult> untangled =
         status == RefineStatus::Cancelled ? std::nullopt : untangle_folds();
     summary.untangled_pairs = untangled_pairs_;
-    const SurfaceState final_state = evaluate_surface(mesh_, flow_views(), SurfaceQuery(mesh_), options_);
+    const SurfaceState final_state = evaluate_surface(mesh_, flow_views(), full_views_, SurfaceQuery(mesh_), options_);
     summary.status = status;
     summary.final_vertices = mesh_.n_vertices();
     summary.final_faces = mesh_.n_faces();
@@ -331,7 +335,9 @@ class Refinement {
     const bool settles_by_noise = options_.stopping.settled_tolerance > 0 && options_.stopping.settled_noise_reference > 0;
     if (settles_by_noise || options_.denoise.use == DenoiseUse::Auto) image_noise_ = estimate_views_noise(full_views_);
     flow_noise_ = image_noise_;
-    if (options_.denoise.use == DenoiseUse::Auto && image_noise_ > options_.denoise.noise_reference) {
+    // With surface patches everywhere no vertex would read the blurred copies (surface_views()).
+    const bool image_patches = options_.photo.photo.surface_patch != SurfacePatchUse::On;
+    if (options_.denoise.use == DenoiseUse::Auto && image_patches && image_noise_ > options_.denoise.noise_reference) {
       denoise_sigma_ = denoise_sigma_for(image_noise_, options_.denoise.noise_reference);
       denoised_ = blurred_views(full_views_, denoise_sigma_);
       // At most the reference: the bisection's σ leaves no more, and rounding must not lift it above.
@@ -466,6 +472,7 @@ class Refinement {
     if (!levels_.empty()) {  // settled on these images: the next finer ones before any refinement
       levels_.pop_back();
       views_ = levels_.empty() ? flow_views() : levels_.back()->views;
+      data_.surface_views = surface_views();
       data_.step_scale = 1.0;  // Σg/vertex on other images says nothing about the steps on these
       data_.previous_g_per_vertex = 0.0;
       data_.damping.reset(mesh_.n_vertices());  // reversals on other images say nothing about these
@@ -538,9 +545,14 @@ class Refinement {
   std::vector<PhotoView> full_views_;  //!< the photographs the refinement may use, as given
   //! Their blurred copies when they are noisy (DenoiseOptions), else null.
   std::unique_ptr<ImageLevel> denoised_;
-  //! The full-resolution views the photo consistency reads: the blurred ones when there are, else
-  //! the photographs as given (the silhouettes always threshold those).
+  //! The full-resolution views the whole-pixel image patches read: the blurred ones when there
+  //! are, else the photographs as given (the silhouettes always threshold those).
   const std::vector<PhotoView>& flow_views() const { return denoised_ ? denoised_->views : full_views_; }
+  //! What the surface patches read instead of views_: the photographs as given while views_ are
+  //! their blurred copies (a blur in the image smears an oblique view's patch along the surface:
+  //! the grazing caps of the noisiest spheres lost up to 79 % with it, README "Convergence");
+  //! null otherwise (on a coarser level the halving has averaged the noise for both kinds).
+  const std::vector<PhotoView>* surface_views() const { return denoised_ && levels_.empty() ? &full_views_ : nullptr; }
   std::vector<std::unique_ptr<ImageLevel>> levels_;  //!< halved once, twice, ...; dropped as the flow gets there
   std::vector<PhotoView> views_;       //!< the views the iterations read now (a level's or the full ones)
   TriMesh mesh_;

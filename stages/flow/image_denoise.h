@@ -1,5 +1,6 @@
 #pragma once
-// Noisy photographs are smoothed before the flow reads them (README, "Convergence"). Image noise
+// Noisy photographs are smoothed before the whole-pixel image patches read them (README,
+// "Convergence"; the patches laid on the surface read the photographs as given). Image noise
 // enters g and, through the Savitzky–Golay samples, ∇g: on renders with σ ≈ 0.006 per grey value
 // the net move over five iterations hovers at 0.4–0.9 % of an edge for 30 iterations and the
 // coarsest level takes 50 iterations instead of 28. A Gaussian blur just strong enough to bring

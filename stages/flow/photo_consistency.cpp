@@ -120,12 +120,14 @@ PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint
 }
 
 void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
-                               const PhotoConsistencyOptions& options, VertexFields& fields) {
+                               const PhotoConsistencyOptions& options, VertexFields& fields,
+                               const std::vector<PhotoView>* surface_views) {
   options.check();
   SurfacePatchLayout layout;
+  const std::vector<PhotoView>& laid = surface_views ? *surface_views : views;
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     const Eigen::Vector3d X = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
-    const PhotoValue value = photo_consistency_at_surface(X, fields.normal[v], fields.visible(v), views, options, layout);
+    const PhotoValue value = photo_consistency_at_surface(X, fields.normal[v], fields.visible(v), views, laid, options, layout);
     fields.photo_consistency[v] = value.defined() ? value.g : 0.0;
     if (value.defined())
       fields.defined[v] |= kPhotoDefined;

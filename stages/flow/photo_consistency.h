@@ -110,8 +110,11 @@ PhotoValue photo_consistency(const Eigen::Vector3d& X, std::span<const std::uint
 
 //! g at every vertex of \p vertices over its visible views (fields.visible_views, from the
 //! visibility stage). Writes photo_consistency and the kPhotoDefined bit of those vertices only.
+//! Surface patches read \p surface_views when given (the same cameras, other photographs), else
+//! \p views.
 void compute_photo_consistency(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
-                               const PhotoConsistencyOptions& options, VertexFields& fields);
+                               const PhotoConsistencyOptions& options, VertexFields& fields,
+                               const std::vector<PhotoView>* surface_views = nullptr);
 
 //! The points of the gradient's 6·half + 1 samples of g around \p X, in the slots the gradient
 //! stage reads: slot 0 = X, then X + s·spacing·e_a for a = x, y, z and s = −half..−1, 1..half.

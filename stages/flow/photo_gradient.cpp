@@ -23,7 +23,8 @@ PhotoGradientStage::PhotoGradientStage(const PhotoGradientOptions& options)
 }
 
 void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views,
-                             double sample_spacing, VertexFields& fields) const {
+                             double sample_spacing, VertexFields& fields,
+                             const std::vector<PhotoView>* surface_views) const {
   MVFLOW_CHECK(sample_spacing > 0, "photo gradient: sample spacing must be positive");
   const int half = options_.savitzky_golay.half_window();
   const PhotoConsistencyOptions& photo = options_.photo;
@@ -34,6 +35,7 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
   std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1));
   std::vector<ViewGainBias> maps;  // with normalisation, one per visible view
   SurfacePatchLayout layout;       // with surface patches
+  const std::vector<PhotoView>& laid = surface_views ? *surface_views : views;  // for surface patches
   const auto position = [&](std::uint32_t v) { return to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v)))); };
   for (std::uint32_t v = vertices.begin; v < vertices.end; ++v) {
     const std::span<const std::uint16_t> visible = fields.visible(v);
@@ -55,10 +57,10 @@ void PhotoGradientStage::run(const TriMesh& mesh, IndexRange vertices, const std
     if (fields.patch_kind[v] != PatchKind::Undecided && fields.patch_kind[v] != kind) defined |= kPatchSwitched;
     fields.patch_kind[v] = kind;
     if (surface) {
-      layout_surface_patch(X, fields.normal[v], visible, views, photo.half_patch, photo.surface_patch_spacing, layout);
+      layout_surface_patch(X, fields.normal[v], visible, laid, photo.half_patch, photo.surface_patch_spacing, layout);
       // The next vertex's rows travel to the cache while this one's samples run.
-      if (v + 1 < vertices.end && surface_everywhere) detail::prefetch_surface_patches(position(v + 1), layout, views);
-      surface_patch_samples(X, sample_spacing, half, layout, views, samples);
+      if (v + 1 < vertices.end && surface_everywhere) detail::prefetch_surface_patches(position(v + 1), layout, laid);
+      surface_patch_samples(X, sample_spacing, half, layout, laid, samples);
     } else if (default_patch) {
       detail::photo_consistency_5x5_samples(X, sample_spacing, half, visible, views, samples);
     } else if (photo.normalize) {

@@ -34,8 +34,11 @@ class PhotoGradientStage {
 
   //! g (photo_consistency, kPhotoDefined) and ∇g (photo_gradient, kGradientDefined) for the
   //! vertices of \p vertices, over their visible views. Writes only those vertices' entries.
+  //! Patches laid on the surface read \p surface_views when given (the same cameras in the same
+  //! order, other photographs: the refinement's blurred views serve the image patches only,
+  //! DenoiseOptions), else \p views.
   void run(const TriMesh& mesh, IndexRange vertices, const std::vector<PhotoView>& views, double sample_spacing,
-           VertexFields& fields) const;
+           VertexFields& fields, const std::vector<PhotoView>* surface_views = nullptr) const;
 
  private:
   PhotoGradientOptions options_;

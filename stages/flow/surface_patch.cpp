@@ -119,9 +119,16 @@ bool uses_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, std:
 PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
                                         std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
                                         const PhotoConsistencyOptions& options, SurfacePatchLayout& layout) {
+  return photo_consistency_at_surface(X, N, view_ids, views, views, options, layout);
+}
+
+PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
+                                        std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
+                                        const std::vector<PhotoView>& surface_views,
+                                        const PhotoConsistencyOptions& options, SurfacePatchLayout& layout) {
   if (!uses_surface_patch(X, N, view_ids, views, options)) return photo_consistency(X, view_ids, views, options);
-  layout_surface_patch(X, N, view_ids, views, options.half_patch, options.surface_patch_spacing, layout);
-  return surface_patch_consistency(X, layout, views);
+  layout_surface_patch(X, N, view_ids, surface_views, options.half_patch, options.surface_patch_spacing, layout);
+  return surface_patch_consistency(X, layout, surface_views);
 }
 
 }  // namespace mvflow

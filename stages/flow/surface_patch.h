@@ -83,5 +83,12 @@ bool uses_surface_patch(const Eigen::Vector3d& X, const Eigen::Vector3d& N, std:
 PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
                                         std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
                                         const PhotoConsistencyOptions& options, SurfacePatchLayout& layout);
+//! The same, with the surface patch read from \p surface_views (the same cameras in the same
+//! order, other photographs: the refinement's blurred views serve the image patches only, see
+//! DenoiseOptions).
+PhotoValue photo_consistency_at_surface(const Eigen::Vector3d& X, const Eigen::Vector3d& N,
+                                        std::span<const std::uint16_t> view_ids, const std::vector<PhotoView>& views,
+                                        const std::vector<PhotoView>& surface_views,
+                                        const PhotoConsistencyOptions& options, SurfacePatchLayout& layout);
 
 }  // namespace mvflow
