@@ -4,8 +4,8 @@
 # mesh, its surface-patch share with the report's counts, and its item-5 verdict with the line's
 # own figures; --compare of a run with itself must give 1.000 and identical meshes, with a shorter
 # run its ratio and none, of two runs against one the ratio of their means; --spread must run
-# the options again with the velocity moved by ±1e-4 relative; an unknown scene name is refused before any work, and a refinement that
-# fails makes it exit 1.
+# the options again with the velocity moved by ±1e-4 relative; an unknown scene name is refused
+# before any work, and a refinement that fails makes it exit 1.
 #   tests/quality_scenes_check.sh MVFLOW SOURCE_DIR WORK_DIR
 set -euo pipefail
 mvflow=$1 root=$2 work=$3

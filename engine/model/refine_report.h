@@ -66,7 +66,7 @@ struct RefineSummary {
   std::size_t self_intersections = 0;     //!< pairs of non-adjacent faces that intersect (final mesh)
   std::size_t untangled_pairs = 0;        //!< crossing face pairs the untangling removed, summed over its calls
   double image_noise = 0.0;               //!< the photographs' noise σ (estimate_views_noise; 0 when not estimated)
-  //! σ in pixels of the Gaussian the flow's photographs were blurred with (DenoiseOptions); 0: as given
+  //! σ in pixels of the Gaussian the image patches' photographs were blurred with (DenoiseOptions); 0: as given
   double denoise_sigma = 0.0;
   double settled_tolerance = 0.0;         //!< the settled rule's tolerance the run used (settled_tolerance_for_noise)
   double seconds = 0.0;

@@ -343,7 +343,6 @@ class Refinement {
       // At most the reference: the bisection's σ leaves no more, and rounding must not lift it above.
       flow_noise_ = std::min(image_noise_ * gaussian_noise_gain(denoise_sigma_), options_.denoise.noise_reference);
     }
-    if (!settles_by_noise) flow_noise_ = 0.0;
     return preparing_error;
   }
 
@@ -566,7 +565,7 @@ class Refinement {
   bool spreads_unmoved_ = false;
   double image_noise_ = 0.0;  //!< estimate_views_noise of the photographs (0 when not needed)
   double denoise_sigma_ = 0.0;  //!< the blur of denoised_ in pixels (0: none)
-  double flow_noise_ = 0.0;     //!< the noise the flow's photographs keep (0 when the settled rule ignores it)
+  double flow_noise_ = 0.0;     //!< the noise the image patches' photographs keep (after the blur)
   int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the hardly observed (the spread is auto without rims: spread_fraction()).

@@ -103,9 +103,7 @@ std::unique_ptr<ImageLevel> blurred_views(const std::vector<PhotoView>& views, d
   level->images.resize(views.size());
   parallel::parallel_for(std::size_t{0}, views.size(),
                          [&](std::size_t i) { level->images[i] = gaussian_blur(*views[i].image, sigma); });
-  std::vector<const Image*> images;
-  for (const Image& image : level->images) images.push_back(&image);
-  level->views = make_photo_views(level->cameras, images);
+  attach_views(*level);
   return level;
 }
 

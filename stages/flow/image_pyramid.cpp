@@ -27,6 +27,12 @@ Camera half_camera(const Camera& camera) {
                 camera.distortion());
 }
 
+void attach_views(ImageLevel& level) {
+  std::vector<const Image*> images;
+  for (const Image& image : level.images) images.push_back(&image);
+  level.views = make_photo_views(level.cameras, images);
+}
+
 std::unique_ptr<ImageLevel> half_resolution(const std::vector<PhotoView>& views) {
   auto level = std::make_unique<ImageLevel>();
   level->cameras.reserve(views.size());
@@ -36,9 +42,7 @@ std::unique_ptr<ImageLevel> half_resolution(const std::vector<PhotoView>& views)
     level->cameras.push_back(half_camera(*view.camera));
     level->images.push_back(half_image(*view.image));
   }
-  std::vector<const Image*> images;
-  for (const Image& image : level->images) images.push_back(&image);
-  level->views = make_photo_views(level->cameras, images);
+  attach_views(*level);
   return level;
 }
 

@@ -24,6 +24,9 @@ struct ImageLevel {
   ImageLevel& operator=(const ImageLevel&) = delete;
 };
 
+//! Fills level.views from its cameras and images (same count and order), once both are in place.
+void attach_views(ImageLevel& level);
+
 //! \p image at half its size: each pixel the mean of a 2×2 block (an odd last row or column is
 //! dropped).
 Image half_image(const Image& image);
