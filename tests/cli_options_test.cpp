@@ -73,6 +73,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--step", {"global", false}},
       {"--step-control", {"on", true}},
       {"--damping", {"off", false}},
+      {"--momentum", {"0.25", 0.25}},
       {"--keep-inside-silhouettes", {"", true}},
       {"--silhouette-threshold", {"0.3", 0.3}},
       {"--silhouette-dilate", {"5", 5}},
@@ -157,7 +158,7 @@ TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
         {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"},
         {"--hardly-observed-first", "-0.1"}, {"--settle-noise-reference", "-0.001"},
-        {"--denoise", "on"}, {"--denoise-reference", "0"}}) {
+        {"--denoise", "on"}, {"--denoise-reference", "0"}, {"--momentum", "1"}}) {
     EXPECT_THROW(options_after(bad), CLI::ParseError) << bad[0] << " " << bad[1];
   }
 }

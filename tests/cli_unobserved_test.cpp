@@ -150,10 +150,12 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   EXPECT_LT(cap_errors(folder / "auto.ply").cap, cap_errors(folder / "off.ply").cap);
 
   // The spread at the end: one more spread than without it, after the last iteration, and it
-  // moves only vertices of the weakly seen caps (the run is the same until then, so the vertex
-  // ids match; measured: 388 vertices moved, none within ±45°). Whether that brings a cap nearer
-  // depends on the scene: on the fifteen of the README 0.988× the error, here this rig's cap
-  // below −75° 0.0091 → 0.0105 (README, "Weakly seen regions").
+  // moves only vertices of the weakly seen parts (the run is the same until then, so the vertex
+  // ids match). Measured: 388 vertices moved, none within ±45°, before the step momentum; with
+  // it a dozen at 27–45° south (the crumpled band of the comment above), none between the rings'
+  // ±20°, and the run ends better (mean 0.0040 → 0.0030, completeness 99.3 → 100 %). Whether the
+  // spread brings a cap nearer depends on the scene: on the fifteen of the README 0.988× the
+  // error, here this rig's cap below −75° 0.0091 → 0.0105 (README, "Weakly seen regions").
   const auto unmoved_off = test::run_mvflow(refine + " -o " +
                                             (folder / "unmoved_off.ply").string() + " --spread-unmoved off");
   ASSERT_EQ(unmoved_off.exit_code, 0) << unmoved_off.output;
@@ -171,15 +173,17 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   const IndexedMesh at_end = io::read_mesh(folder / "auto.ply");
   const IndexedMesh not_at_end = io::read_mesh(folder / "unmoved_off.ply");
   ASSERT_EQ(at_end.positions.size(), not_at_end.positions.size());
-  std::size_t moved_at_end = 0;
+  std::size_t moved_at_end = 0, in_caps = 0;
   for (std::size_t v = 0; v < at_end.positions.size(); ++v) {
     const Eigen::Vector3d& p = not_at_end.positions[v];
     if (at_end.positions[v] == p) continue;
     ++moved_at_end;
-    EXPECT_GT(std::abs(p.y() / p.norm()), std::sin(std::numbers::pi / 4))
-        << "vertex " << v << " moved at " << p.transpose();
+    const double sine = std::abs(p.y() / p.norm());
+    in_caps += sine > std::sin(std::numbers::pi / 4);
+    EXPECT_GT(sine, std::sin(std::numbers::pi / 9)) << "vertex " << v << " moved at " << p.transpose();
   }
   EXPECT_GT(moved_at_end, 50u);
+  EXPECT_GT(in_caps, 9 * moved_at_end / 10) << in_caps << " of " << moved_at_end;
 
   // The first resolution's spread takes the vertices with a speed in at most 3/4 of its
   // iterations (--hardly-observed-first), a superset of those in at most 1/4 and a subset of

@@ -1,6 +1,6 @@
-// Per-vertex step damping and the net move along the normal (issue 12: convergence that tells
-// drift from progress): hand-made speeds, an analytic stiff case, and spheres moved by known
-// amounts.
+// Per-vertex step damping and momentum and the net move along the normal (issue 12: convergence
+// that tells drift from progress): hand-made speeds, an analytic stiff case, and spheres moved by
+// known amounts.
 
 #include <gtest/gtest.h>
 
@@ -12,6 +12,7 @@
 #include "stages/flow/net_move.h"
 #include "stages/flow/speed.h"  // compute_local_edges, median_of
 #include "stages/flow/step_damping.h"
+#include "stages/flow/step_momentum.h"
 #include "stages_meshes.h"
 
 namespace mvflow {
@@ -133,6 +134,69 @@ TEST(StepDamping, TheWholeSpeedIsScaledSoItsZerosStay) {
   damp_speeds({0, 1}, StepDampingOptions{}, fields, state);
   EXPECT_EQ(fields.speed[0], Eigen::Vector3d(7, 8, 9));
   EXPECT_EQ(state.normal_speed[0], 0.0);
+}
+
+TEST(StepMomentum, OptionsAreChecked) {
+  EXPECT_NO_THROW(StepMomentumOptions{}.check());
+  EXPECT_NO_THROW(StepMomentumOptions{.carry = 0.0}.check());
+  EXPECT_THROW(StepMomentumOptions{.carry = 1.0}.check(), OptionError);
+  EXPECT_THROW(StepMomentumOptions{.carry = -0.1}.check(), OptionError);
+}
+
+TEST(StepMomentum, IsTheHeavyBallOnASteadyApproach) {
+  // The stiff vertex with dt·k = a = 0.05 (a slow, steady approach): plain steps multiply x by
+  // 1 − a; carrying β of the last step gives x' = (1 − a)·x + β·(x − x_prev), whose roots
+  // r² − (1 − a + β)·r + β = 0 are real for β = 0.5 (0.885 and 0.565), so x falls monotonically,
+  // the momentum always agrees with the speed, and it is never dropped.
+  const double k = 0.05, dt = 1.0, beta = 0.5;
+  StiffVertex carried;
+  std::vector<Eigen::Vector3d> last_step;  // empty: nothing to carry at the first step
+  double x = 1.0, x_prev = 1.0;            // the recurrence, written out
+  int plain_steps = 0, carried_steps = 0;
+  for (double plain = 1.0; plain > 1e-3; plain *= 1.0 - dt * k) ++plain_steps;
+  for (int step = 0; step < 400 && carried.x > 1e-3; ++step, ++carried_steps) {
+    carried.set_speed(k);
+    carry_momentum({0, 1}, StepMomentumOptions{.carry = beta}, dt, last_step, carried.fields);
+    const double before = carried.x;
+    carried.x += dt * carried.fields.speed[0].z();
+    last_step.assign(1, (carried.x - before) * Eigen::Vector3d::UnitZ());
+    const double next = (1.0 - dt * k) * x + beta * (x - x_prev);
+    x_prev = x;
+    x = next;
+    EXPECT_NEAR(carried.x, x, 1e-12) << step;
+  }
+  EXPECT_EQ(plain_steps, 135);  // ⌈ln 1e−3 / ln 0.95⌉
+  // The slower root, 0.885 per step, alone would take ⌈ln 1e−3 / ln 0.885⌉ = 57; the first step
+  // has no momentum and the faster root's share decays first: 59 (the recurrence run alone).
+  EXPECT_EQ(carried_steps, 59);
+}
+
+TEST(StepMomentum, OpposingMomentumIsDroppedAndARestingVertexStaysAtRest) {
+  VertexFields fields;
+  fields.resize(4, 0);
+  const Eigen::Vector3d n = Eigen::Vector3d(1, 2, 2) / 3.0;
+  const Eigen::Vector3d tangent = Eigen::Vector3d(2, 1, -2) / 3.0;  // ⟂ n
+  for (int v = 0; v < 4; ++v) {
+    fields.normal[v] = n;
+    fields.defined[v] = kSpeedDefined;
+    fields.speed[v] = 2.0 * n + tangent;
+  }
+  fields.defined[3] = 0;
+  const std::vector<Eigen::Vector3d> last_step = {0.3 * n + 5.0 * tangent,  // agrees: 0.5·0.3/0.1 along n
+                                                  -0.3 * n + tangent,       // opposes the speed: dropped
+                                                  4.0 * tangent,            // at rest along the normal
+                                                  0.3 * n};                 // no defined speed
+  carry_momentum({0, 4}, StepMomentumOptions{.carry = 0.5}, 0.1, last_step, fields);
+  EXPECT_NEAR((fields.speed[0] - ((2.0 + 1.5) * n + tangent)).norm(), 0.0, 1e-14);
+  for (int v = 1; v < 4; ++v) EXPECT_EQ(fields.speed[v], Eigen::Vector3d(2.0 * n + tangent)) << v;
+  // Nothing to carry, or carry 0: the speeds stay bit for bit.
+  VertexFields same = fields;
+  carry_momentum({0, 4}, StepMomentumOptions{.carry = 0.5}, 0.1, {}, same);
+  carry_momentum({0, 4}, StepMomentumOptions{.carry = 0.0}, 0.1, last_step, same);
+  for (int v = 0; v < 4; ++v) EXPECT_EQ(same.speed[v], fields.speed[v]);
+  EXPECT_THROW(carry_momentum({0, 4}, StepMomentumOptions{}, 0.0, last_step, fields), Error);
+  EXPECT_THROW(carry_momentum({0, 4}, StepMomentumOptions{}, 0.1, {Eigen::Vector3d::Zero()}, fields), Error);
+  EXPECT_THROW(carry_momentum({0, 5}, StepMomentumOptions{}, 0.1, last_step, fields), Error);
 }
 
 // Fields for \p mesh with outward sphere normals, a speed everywhere and the shortest edges.

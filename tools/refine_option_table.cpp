@@ -298,6 +298,10 @@ std::vector<RefineOptionEntry> make_table() {
                      "Per-vertex step damping: halve a vertex's step when its speed along the normal reverses, "
                      "grow it back toward the CFL step while it does not (thesis preset: off)",
                      [](auto& o) -> auto& { return o.damping.enabled; }));
+  t.push_back(value("--momentum", "step_momentum", "momentum.carry",
+                    "Per-vertex step momentum β: a vertex moving the same way along its normal as in the last "
+                    "iteration carries β of that whole step into this one (0 = off, the thesis preset)",
+                    [](auto& o) -> auto& { return o.momentum.carry; }));
   t.push_back(switch_flag("--keep-inside-silhouettes", "keep_inside_silhouettes",
                           "Keep the surface inside the visual hull of the used views' silhouettes (photographs on a "
                           "dark background)",

@@ -95,7 +95,7 @@ void IterationData::refit() {
   StageTimer timer(serial_seconds[static_cast<int>(Stage::Refit)]);
   if (refit_needed) surface->update_positions(mesh);
   refit_needed = true;  // every later iteration moves the vertices first
-  if (options.unobserved.fill) {
+  if (options.unobserved.fill || options.momentum.carry > 0.0) {
     const std::size_t n = mesh.n_vertices();
     if (iteration_start.size() == n) {
       last_step.resize(n);
@@ -216,6 +216,7 @@ void IterationData::move(std::size_t block) {
   run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::Move)],
             [&] {
               if (options.damping.enabled) damp_speeds(blocks[block], options.damping, fields, damping);
+              if (time_step > 0.0) carry_momentum(blocks[block], options.momentum, time_step, last_step, fields);
               move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside, &moved);
             });
 }

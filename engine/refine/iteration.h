@@ -26,6 +26,7 @@
 #include "stages/flow/silhouette.h"
 #include "stages/flow/speed.h"
 #include "stages/flow/step_damping.h"
+#include "stages/flow/step_momentum.h"
 
 namespace mvflow {
 
@@ -60,8 +61,8 @@ struct IterationData {
   std::vector<BlockPartial> partials;            //!< one per block
   std::vector<Eigen::Vector3d> new_positions;    //!< Jacobi buffer of smoothing / regularization
   std::vector<double> moved;                     //!< length of each vertex's move this iteration
-  //! For the unobserved-speed fill: the positions at the start of the last iteration (empty
-  //! until one ran on this topology), then each vertex's whole step in it (refit()).
+  //! For the step momentum and the unobserved-speed fill: the positions at the start of the last
+  //! iteration (empty until one ran on this topology), then each vertex's whole step in it (refit()).
   std::vector<Eigen::Vector3d> iteration_start, last_step;
   double last_time_step = 0.0;
   std::vector<std::array<double, kStageCount>> block_seconds;  //!< per block, per stage
@@ -115,7 +116,8 @@ struct IterationData {
   void cfl();                          //!< serial: combine partials in block order, Δt, median move
   void adapt_step_scale();             //!< part of cfl(): the step control
   void fill_speeds();                  //!< part of cfl(): speeds of unobserved vertices
-  void move(std::size_t block);        //!< the steps damped (options.damping), then P ← P + Δt·F
+  //! the steps damped (options.damping), the last steps carried (options.momentum), then P ← P + Δt·F
+  void move(std::size_t block);
   void measure_moves();                //!< serial, after the iteration: median_move and net_move_over_edge
   void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
   void inflate(std::size_t block);     //!< new position of Taubin's second step (taubin_pass_band > 0)

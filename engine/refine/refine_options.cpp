@@ -17,6 +17,7 @@ void RefineOptions::check() const {
   require_option(cfl > 0 && cfl <= 10, "cfl", cfl, "(0, 10]");
   require_option(speed_quantile > 0 && speed_quantile <= 1, "speed_quantile", speed_quantile, "(0, 1]");
   check_member(damping, "damping");
+  check_member(momentum, "momentum");
   check_member(smoothing, "smoothing");
   check_member(regularization, "regularization");
   check_member(stopping, "stopping");
@@ -46,6 +47,7 @@ RefineOptions thesis_preset() {
   options.stopping.settled_tolerance = 0.0;
   options.stopping.settled_noise_reference = 0.0;
   options.damping.enabled = false;
+  options.momentum.carry = 0.0;
   options.speed_quantile = 1.0;
   options.local_step = false;
   options.step_control = false;

@@ -17,6 +17,7 @@
 #include "stages/flow/smoothing.h"
 #include "stages/flow/speed.h"
 #include "stages/flow/step_damping.h"
+#include "stages/flow/step_momentum.h"
 #include "stages/flow/stopping.h"
 #include "stages/flow/unobserved_displacement.h"
 #include "stages/flow/unobserved_speed.h"
@@ -67,6 +68,8 @@ struct RefineOptions {
   bool step_control = false;
   //! Per-vertex step damping (stages/flow/step_damping.h): on by default; off in the thesis preset.
   StepDampingOptions damping;
+  //! Per-vertex step momentum (stages/flow/step_momentum.h): β = 0.7 by default; 0 in the thesis preset.
+  StepMomentumOptions momentum;
   SmoothingOptions smoothing;
   RegularizationOptions regularization;
   StoppingOptions stopping;
