@@ -20,13 +20,17 @@ namespace mvflow::fuzz {
 
 //! This process's folder for inputs, created on first use and removed at exit.
 inline const std::filesystem::path& work_folder() {
-  static const std::filesystem::path folder = [] {
-    const auto path = std::filesystem::temp_directory_path() / ("mvflow-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(path);
+  // Never destroyed: a static path object would be destroyed before the atexit handler (its
+  // destructor is registered after the handler, when the initializer returns), which then
+  // removed nothing and left a folder in /tmp behind every fuzz run.
+  static const std::filesystem::path* const folder = [] {
+    const auto* path =
+        new std::filesystem::path(std::filesystem::temp_directory_path() / ("mvflow-fuzz-" + std::to_string(::getpid())));
+    std::filesystem::create_directories(*path);
     std::atexit([] { std::error_code ignored; std::filesystem::remove_all(work_folder(), ignored); });
     return path;
   }();
-  return folder;
+  return *folder;
 }
 
 //! Writes \p size bytes to \p name in \p folder (default: the work folder) and returns its path.
