@@ -189,6 +189,11 @@ TEST(RefineOptionTable, RangesAreCheckedOnceEveryFlagIsApplied) {
   EXPECT_EQ(refusal({"--smoothing", "0.95", "--taubin-pass-band", "0"}), "");
   EXPECT_EQ(refusal({"--smoothing", "0.95"}).rfind("--taubin-pass-band: option smoothing.taubin_pass_band = 0.1", 0), 0u);
   EXPECT_EQ(refusal({"--min-iterations", "300", "--max-iterations", "400"}), "");
+  // A choice refused only in combination: named by its own flag too.
+  EXPECT_EQ(refusal({"--surface-patch", "on", "--normalize", "on"}),
+            "--surface-patch: option photo.photo.surface_patch = on is out of range: expected off or oblique when "
+            "normalize is on");
+  EXPECT_EQ(refusal({"--surface-patch", "on"}), "");
 }
 
 TEST(RefineOptionTable, HelpQuotesTheValidValuesOfTheStagesChecks) {

@@ -67,11 +67,13 @@ RefineOptionEntry value(std::string flag, std::string key, std::string member, s
 // How a choice appears in the report: by its name, or as the field's own value (bool fields).
 enum class ReportAs { Name, Value };
 
-// A field set from one of a few names.
+// A field set from one of a few names. CLI11 refuses any other name; \p member (the field's path
+// in RefineOptions::check) is needed only where check() can still refuse a name in combination
+// with another option, so that the refusal names this flag (and --help lists the names).
 template <typename Get>
 RefineOptionEntry choice(std::string flag, std::string key, std::string help,
                          std::vector<std::pair<std::string, FieldType<Get>>> names, Get get,
-                         ReportAs report = ReportAs::Name) {
+                         ReportAs report = ReportAs::Name, std::string member = "") {
   auto name_of = [names](const FieldType<Get>& v) {
     for (const auto& [name, value] : names)
       if (value == v) return name;
@@ -79,9 +81,14 @@ RefineOptionEntry choice(std::string flag, std::string key, std::string help,
   };
   std::vector<std::string> allowed;
   for (const auto& entry : names) allowed.push_back(entry.first);
-  return {flag, key, {},
+  std::string listed;
+  for (const std::string& name : allowed) listed += (listed.empty() ? "" : ", ") + name;
+  const std::string description = member.empty() ? help : with_valid_values(help, listed);
+  std::vector<std::string> members;
+  if (!member.empty()) members.push_back(member);
+  return {flag, key, members,
           [=](CLI::App& command) {
-            return command.add_option(flag, help)
+            return command.add_option(flag, description)
                 ->type_name("TEXT")
                 ->check(CLI::IsMember(allowed))
                 ->default_str(name_of(get(defaults())));
@@ -179,7 +186,8 @@ std::vector<RefineOptionEntry> make_table() {
                      {{"off", SurfacePatchUse::Off},
                       {"oblique", SurfacePatchUse::Oblique},
                       {"on", SurfacePatchUse::On}},
-                     [](auto& o) -> auto& { return o.photo.photo.surface_patch; }));
+                     [](auto& o) -> auto& { return o.photo.photo.surface_patch; }, ReportAs::Name,
+                     "photo.photo.surface_patch"));  // on is refused with --normalize on
   t.push_back(value("--surface-patch-angle", "photo_surface_patch_angle", "photo.photo.surface_patch_angle_degrees",
                     "--surface-patch oblique: a vertex with a view farther than this from its normal (degrees) lays "
                     "its patch on the surface",

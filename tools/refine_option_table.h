@@ -20,7 +20,8 @@ struct RefineOptionEntry {
   std::string flag;  //!< e.g. "--cfl"
   std::string key;   //!< e.g. "cfl" in the report's "options"
   //! The fields it sets as RefineOptions::check names them ("smoothing.lambda_dt"), so that a value
-  //! out of range is reported under the flag; empty for choices (CLI11 checks those).
+  //! out of range is reported under the flag; empty for most choices (CLI11 checks those), but
+  //! not for a choice that check() can refuse in combination with another option.
   std::vector<std::string> members;
   //! Registers the flag on \p command with its help, for --help its valid values and the default
   //! preset's value.
