@@ -9,8 +9,9 @@
 // waist approaches for 50–100 iterations. Carrying β of the last step multiplies a steady
 // approach by up to 1/(1 − β) without touching the fast vertices' CFL bound. It is the whole
 // step (flow, smoothing, regularization, rims) that is carried, not the flow's move alone, so a
-// surface at rest (last step 0) is a rest point still: the equilibrium between the flow and the
-// smoothing, and so the accuracy, is unchanged. Momentum that opposes this iteration's speed is
+// surface at rest (last step 0) is a rest point still: wherever the surface comes to rest, the
+// flow and the smoothing balance there as they do without momentum (carrying the flow's move
+// alone would scale the flow against the smoothing). Momentum that opposes this iteration's speed is
 // dropped (the gradient restart of O'Donoghue & Candès, 2015): a vertex crossing the minimum of
 // g stops at once instead of overshooting, and the step damping takes over.
 
