@@ -27,6 +27,8 @@ nlohmann::json iteration_json(const IterationReport& r) {
           {"time_step", r.time_step},
           {"median_move_over_cfl_edge", r.median_move},
           {"net_normal_move_over_edge", std::isfinite(r.net_move) ? nlohmann::json(r.net_move) : nlohmann::json(nullptr)},
+          {"net_normal_move_p90_over_edge",
+           std::isfinite(r.net_move_tail) ? nlohmann::json(r.net_move_tail) : nlohmann::json(nullptr)},
           {"stop", r.stop},
           {"seconds", r.seconds},
           {"stage_seconds", stages}};

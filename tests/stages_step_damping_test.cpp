@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -230,6 +231,11 @@ TEST(NetNormalMove, IsTheRadialGrowthOverTheWindowInShortestEdges) {
   std::vector<double> expected;
   for (std::size_t v = 0; v < mesh.n_vertices(); ++v) expected.push_back(0.005 / fields.local_edge[v]);
   EXPECT_NEAR(net.record(mesh, fields), median_of(expected), 1e-9);
+  // The tail: rank ⌈0.9·n⌉ of the ascending ratios, taken here by a full sort.
+  std::sort(expected.begin(), expected.end());
+  const auto rank = static_cast<std::size_t>(std::ceil(0.9 * static_cast<double>(expected.size()))) - 1;
+  EXPECT_NEAR(net.last_tail(), expected[rank], 1e-9);
+  EXPECT_GT(net.last_tail(), median_of(expected));  // the shortest edges vary over an icosphere
   // An oscillation around one radius, ±0.001 in turn. Over an even window of 4 it cancels, though
   // every single step is 0.002 long.
   const TriMesh base = mesh;
@@ -237,11 +243,17 @@ TEST(NetNormalMove, IsTheRadialGrowthOverTheWindowInShortestEdges) {
   for (int i = 0; i < 12; ++i) {
     for (auto v : mesh.vertices()) mesh.set_point(v, base.point(v) * (1.0 + (i % 2 ? -0.001 : 0.001)));
     const double value = even.record(mesh, fields);
-    if (i >= 4) EXPECT_NEAR(value, 0.0, 1e-12) << i;
-    else EXPECT_TRUE(std::isnan(value)) << i;
+    if (i >= 4) {
+      EXPECT_NEAR(value, 0.0, 1e-12) << i;
+      EXPECT_NEAR(even.last_tail(), 0.0, 1e-12) << i;
+    } else {
+      EXPECT_TRUE(std::isnan(value)) << i;
+      EXPECT_TRUE(std::isnan(even.last_tail())) << i;
+    }
   }
   // reset() forgets the positions: NaN again.
   even.reset();
+  EXPECT_TRUE(std::isnan(even.last_tail()));
   EXPECT_TRUE(std::isnan(even.record(mesh, fields)));
   // A vertex count change without reset is refused.
   TriMesh other = icosphere(1.0, 2);

@@ -44,6 +44,9 @@ struct IterationReport {
   //! median over the moving vertices of their net move along the normal over the stopping rule's
   //! lookback, divided by their shortest edge (NetNormalMove); NaN in the first iterations of a topology
   double net_move = 0.0;
+  //! the 90th percentile of the same (NetNormalMove::last_tail): the vertices still on their way
+  //! when the median has settled; NaN where net_move is
+  double net_move_tail = 0.0;
   std::string stop;                   //!< "continue", or why the refinement stops after it
   double seconds = 0.0;               //!< wall time of the whole iteration
   std::array<double, kStageCount> stage_seconds{};

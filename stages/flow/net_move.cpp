@@ -1,6 +1,8 @@
 #include "stages/flow/net_move.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 #include "engine/model/error.h"
@@ -16,6 +18,7 @@ NetNormalMove::NetNormalMove(int window) : window_(window) {
 void NetNormalMove::reset() {
   next_ = 0;
   recorded_ = 0;
+  last_tail_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 double NetNormalMove::record(const TriMesh& mesh, const VertexFields& fields) {
@@ -28,6 +31,7 @@ double NetNormalMove::record(const TriMesh& mesh, const VertexFields& fields) {
   for (std::size_t v = 0; v < n; ++v) now[v] = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
   next_ = (next_ + 1) % ring_.size();
   ++recorded_;
+  last_tail_ = std::numeric_limits<double>::quiet_NaN();
   if (recorded_ < ring_.size()) return std::numeric_limits<double>::quiet_NaN();
 
   const std::vector<Eigen::Vector3d>& before = ring_[next_];  // the oldest: window iterations ago
@@ -40,6 +44,10 @@ double NetNormalMove::record(const TriMesh& mesh, const VertexFields& fields) {
     relative.push_back(std::abs((now[v] - before[v]).dot(fields.normal[v])) / edge);
   }
   if (relative.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto tail = relative.begin() +
+                    static_cast<std::ptrdiff_t>(std::ceil(0.9 * static_cast<double>(relative.size()))) - 1;
+  std::nth_element(relative.begin(), tail, relative.end());
+  last_tail_ = *tail;
   return median_of(std::move(relative));
 }
 
