@@ -82,7 +82,6 @@ void IterationData::reset_topology() {
   on_rim.assign(mesh.n_vertices(), 0);
   net_move.reset();
   net_move_over_edge = std::numeric_limits<double>::quiet_NaN();
-  net_move_tail_over_edge = std::numeric_limits<double>::quiet_NaN();
 }
 
 void IterationData::set_edge_lengths(const EdgeLengths& edges) {
@@ -201,7 +200,6 @@ void IterationData::measure_moves() {
   }
   median_move = median_of(relative);
   net_move_over_edge = net_move.record(mesh, fields);
-  net_move_tail_over_edge = net_move.last_tail();
 }
 
 void IterationData::adapt_step_scale() {

@@ -86,7 +86,6 @@ struct IterationData {
   //! Set by measure_moves(): NetNormalMove::record over options.stopping.lookback iterations (NaN
   //! until that many ran on this topology).
   double net_move_over_edge = 0.0;
-  double net_move_tail_over_edge = 0.0;  //!< the 90th percentile of the same (NetNormalMove::last_tail)
   //! Set by cfl(): the vertices with defined g from a surface patch, and those whose kind of patch
   //! changed since the previous iteration (VertexFields::patch_kind).
   std::size_t surface_patch_g = 0;
@@ -119,7 +118,7 @@ struct IterationData {
   void fill_speeds();                  //!< part of cfl(): speeds of unobserved vertices
   //! the steps damped (options.damping), the last steps carried (options.momentum), then P ← P + Δt·F
   void move(std::size_t block);
-  void measure_moves();                //!< serial, after the iteration: median_move and the net moves
+  void measure_moves();                //!< serial, after the iteration: median_move and net_move_over_edge
   void smooth(std::size_t block);      //!< new position of curvature-normal smoothing
   void inflate(std::size_t block);     //!< new position of Taubin's second step (taubin_pass_band > 0)
   void regularize(std::size_t block);  //!< normals at the current positions, then regularization

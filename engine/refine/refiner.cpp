@@ -516,7 +516,7 @@ class Refinement {
     report.time_step = data_.time_step;
     report.median_move = data_.median_move;
     report.net_move = data_.net_move_over_edge;
-    report.net_move_tail = data_.net_move_tail_over_edge;
+    report.net_move_tail = data_.net_move.last_tail();  // NaN after a reset, as net_move
     for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] = data_.serial_seconds[s];
     for (const auto& slots : data_.block_seconds)  // block order: the same sum every run
       for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] += slots[s];
