@@ -21,6 +21,7 @@ nlohmann::json iteration_json(const IterationReport& r) {
           {"defined_g", r.defined_g},
           {"surface_patch_g", r.surface_patch_g},
           {"patch_switches", r.patch_switches},
+          {"far_vertices", r.far_vertices},
           {"moving_vertices", r.moving},
           {"shortest_edge", r.shortest_edge},
           {"max_speed", r.max_speed},

@@ -31,6 +31,9 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--preferred-view-angle", {"50", 50.0}},
       {"--min-views", {"4", 4}},
       {"--image-levels", {"2", 2}},
+      {"--far-g-ratio", {"50", 50.0}},
+      {"--far-view-angle", {"45", 45.0}},
+      {"--far-release", {"0.5", 0.5}},
       {"--normalize", {"on", true}},
       {"--denoise", {"off", "off"}},
       {"--denoise-reference", {"0.004", 0.004}},
@@ -158,7 +161,8 @@ TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
         {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--hardly-observed", "1.5"},
         {"--hardly-observed-first", "-0.1"}, {"--settle-noise-reference", "-0.001"},
-        {"--denoise", "on"}, {"--denoise-reference", "0"}, {"--momentum", "1"}}) {
+        {"--denoise", "on"}, {"--denoise-reference", "0"}, {"--momentum", "1"},
+        {"--far-g-ratio", "0.5"}, {"--far-view-angle", "0"}, {"--far-release", "2"}}) {
     EXPECT_THROW(options_after(bad), CLI::ParseError) << bad[0] << " " << bad[1];
   }
 }

@@ -98,6 +98,9 @@ std::vector<RefineOptions> determinism_cases() {
   RefineOptions optional_rules = by_default;
   optional_rules.step_control = true;
   optional_rules.keep_inside_silhouettes = true;
+  // ... and far vertices on half-resolution photographs: at 3 × the median g many vertices are
+  // far, so runs of far and near vertices alternate within every block.
+  optional_rules.far.g_ratio = 3.0;
   optional_rules.silhouettes.threshold = 0.6;
   // The options for real photographs: coarser images first, speeds filled for unobserved and
   // obliquely seen vertices, outlier views dropped, at most 5 views.
@@ -137,6 +140,19 @@ void expect_same_bits(const RefineOptions& options) {
   if (options.denoise.noise_reference < 0.001) {
     EXPECT_GT(reference.summary.denoise_sigma, 0.0);
   }
+  if (options.far.g_ratio > 0.0 && options.far.g_ratio < 10.0) {
+    // Far vertices at the first resolution only, none after the first refinement.
+    std::size_t far = 0;
+    bool refined = false;
+    for (const IterationReport& r : reference.summary.iterations) {
+      if (refined) {
+        EXPECT_EQ(r.far_vertices, 0u) << r.iteration;
+      }
+      far += r.far_vertices;
+      refined = refined || r.refined_faces > 0;
+    }
+    EXPECT_GT(far, 0u) << "the case must exercise far vertices";
+  }
   for (const RefineResult* other : {&single, &blocks, &plain}) {
     ASSERT_EQ(other->summary.iterations.size(), reference.summary.iterations.size());
     EXPECT_EQ(positions(*other), positions(reference));  // exact, not approximate
@@ -146,6 +162,7 @@ void expect_same_bits(const RefineOptions& options) {
       EXPECT_EQ(other->summary.iterations[i].time_step, reference.summary.iterations[i].time_step);
       EXPECT_EQ(other->summary.iterations[i].surface_patch_g, reference.summary.iterations[i].surface_patch_g);
       EXPECT_EQ(other->summary.iterations[i].patch_switches, reference.summary.iterations[i].patch_switches);
+      EXPECT_EQ(other->summary.iterations[i].far_vertices, reference.summary.iterations[i].far_vertices);
       // NaN in the first iterations of each topology: compared as bits.
       EXPECT_EQ(std::bit_cast<std::uint64_t>(other->summary.iterations[i].net_move),
                 std::bit_cast<std::uint64_t>(reference.summary.iterations[i].net_move));

@@ -169,6 +169,16 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(value("--image-levels", "image_levels", "image_levels",
                     "Start on the photographs halved this many times, one level finer each time the flow settles",
                     [](auto& o) -> auto& { return o.image_levels; }));
+  t.push_back(value("--far-g-ratio", "far_g_ratio", "far.g_ratio",
+                    "At the first resolution a vertex whose g exceeds this multiple of the median g reads the "
+                    "photographs at half resolution until it comes near (0 = never, the thesis preset)",
+                    [](auto& o) -> auto& { return o.far.g_ratio; }));
+  t.push_back(value("--far-view-angle", "far_view_angle_degrees", "far.view_angle_degrees",
+                    "... if one of its views lies within this angle of its normal (degrees)",
+                    [](auto& o) -> auto& { return o.far.view_angle_degrees; }));
+  t.push_back(value("--far-release", "far_release", "far.release",
+                    "A far vertex is near again when its g falls below this fraction of --far-g-ratio times the median",
+                    [](auto& o) -> auto& { return o.far.release; }));
   t.push_back(choice("--denoise", "denoise",
                      "Photographs whose estimated noise is above --denoise-reference are blurred (Gaussian) just "
                      "enough to bring it there for the whole-pixel image patches (surface patches read them as "

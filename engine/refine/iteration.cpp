@@ -11,6 +11,7 @@
 #include "engine/model/parallel.h"
 #include "stages/flow/commit.h"
 #include "stages/flow/curvature.h"
+#include "stages/flow/far_vertices.h"
 #include "stages/flow/normals.h"
 #include "stages/flow/photo_robust.h"
 #include "stages/flow/regularization.h"
@@ -71,6 +72,8 @@ void IterationData::reset_topology() {
   partials.assign(blocks.size(), BlockPartial{});
   new_positions.assign(mesh.n_vertices(), Eigen::Vector3d::Zero());
   moved.assign(mesh.n_vertices(), 0.0);
+  far.assign(mesh.n_vertices(), 0);
+  far_count = 0;
   block_seconds.assign(blocks.size(), {});
   refit_needed = false;
   iteration_start.clear();
@@ -123,6 +126,22 @@ void IterationData::visibility(std::size_t block) {
 }
 
 void IterationData::photo_speed(std::size_t block) {
+  // Each run of consecutive vertices that are all far or all near, on its own photographs.
+  const auto photo_of = [&](std::uint32_t begin, std::uint32_t end) {
+    if (far_views == nullptr || far_count == 0) {
+      photo.run(mesh, {begin, end}, views, sample_spacing, fields, surface_views);
+      return;
+    }
+    for (std::uint32_t first = begin; first < end;) {
+      std::uint32_t last = first + 1;
+      while (last < end && far[last] == far[first]) ++last;
+      if (far[first])
+        photo.run(mesh, {first, last}, *far_views, sample_spacing, fields);  // surface patches on them too
+      else
+        photo.run(mesh, {first, last}, views, sample_spacing, fields, surface_views);
+      first = last;
+    }
+  };
   run_block(*this, block, &block_seconds[block][static_cast<int>(Stage::PhotoGradient)], [&] {
     if (options.engine == EngineKind::Graph) {
       // Idle threads take parts of a long photo node (nested parallelism: the graph is the coarse
@@ -130,10 +149,10 @@ void IterationData::photo_speed(std::size_t block) {
       const IndexRange range = blocks[block];
       parallel::parallel_for(oneapi::tbb::blocked_range<std::uint32_t>(range.begin, range.end, kPhotoGrain),
                              [&](const oneapi::tbb::blocked_range<std::uint32_t>& part) {
-                               photo.run(mesh, {part.begin(), part.end()}, views, sample_spacing, fields, surface_views);
+                               photo_of(part.begin(), part.end());
                              });
     } else {
-      photo.run(mesh, blocks[block], views, sample_spacing, fields, surface_views);
+      photo_of(blocks[block].begin, blocks[block].end);
     }
     compute_speed(blocks[block], options.speed, fields);
     partials[block] = reduce_block(blocks[block], fields);
@@ -157,6 +176,7 @@ void IterationData::cfl() {
     }
   }
   total.sum_g = sum_g;
+  far_count = far_views != nullptr ? update_far_vertices(mesh, views, fields, options.far, far) : 0;
   // Before the step: weakly seen vertices only follow it, so they leave the maximum too.
   if (demote_weakly_seen(mesh, views, options.unobserved, fields) > 0) {
     total.max_speed = 0.0;

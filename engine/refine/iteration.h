@@ -51,6 +51,11 @@ struct IterationData {
   //! The photographs the surface patches read when they differ from `views` (the photographs as
   //! given while `views` are their blurred copies, DenoiseOptions); null: `views`.
   const std::vector<PhotoView>* surface_views = nullptr;
+  //! The photographs at half resolution that the far vertices read (FarVertexOptions), while the
+  //! refinement uses them (the first resolution); null: no vertex is far.
+  const std::vector<PhotoView>* far_views = nullptr;
+  //! One flag per vertex, 1 = far (update_far_vertices, by cfl()); read by the next photo_speed.
+  std::vector<std::uint8_t> far;
   //! One flag per vertex: it made a view's outline in the last iteration (only when the rims are
   //! fitted; the silhouettes observe it, so the unobserved spread leaves it where it is).
   std::vector<std::uint8_t> on_rim;
@@ -91,6 +96,7 @@ struct IterationData {
   std::size_t surface_patch_g = 0;
   std::size_t patch_switches = 0;
   std::size_t moving = 0;
+  std::size_t far_count = 0;  //!< set by cfl(): the far vertices for the next iteration (0 without far_views)
   double serial_seconds[kStageCount] = {};
 
   //! Sizes everything for the mesh's current topology (new blocks, fields, Embree scene).

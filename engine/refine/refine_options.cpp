@@ -26,6 +26,7 @@ void RefineOptions::check() const {
   check_member(untangling, "untangling");
   require_option(block_size >= 1, "block_size", block_size, ">= 1");
   require_option(image_levels >= 0 && image_levels <= 4, "image_levels", image_levels, "[0, 4]");
+  check_member(far, "far");
   check_member(denoise, "denoise");
   check_member(silhouettes, "silhouettes");
   check_member(rims, "rims");
@@ -61,6 +62,7 @@ RefineOptions thesis_preset() {
   options.unobserved_displacement.spread = UnobservedSpread::Off;
   options.photo.photo.surface_patch = SurfacePatchUse::Off;
   options.denoise.use = DenoiseUse::Off;
+  options.far.g_ratio = 0.0;
   return options;
 }
 

@@ -8,6 +8,7 @@
 
 #include "stages/topology/adaptive_refinement.h"
 #include "stages/flow/curvature.h"
+#include "stages/flow/far_vertices.h"
 #include "stages/flow/image_denoise.h"
 #include "stages/flow/photo_gradient.h"
 #include "stages/flow/regularization.h"
@@ -83,6 +84,11 @@ struct RefineOptions {
   //! refinement (with either schedule) waits for the full resolution; 0 = full resolution
   //! throughout (the thesis). 0..4.
   int image_levels = 0;
+  //! Far vertices (stages/flow/far_vertices.h): at the first resolution, a vertex whose g is
+  //! g_ratio × the median reads half-resolution photographs until it comes near. On by default
+  //! (g_ratio 300); off in the thesis preset and whenever image_levels > 0 (every vertex starts
+  //! on coarser images then).
+  FarVertexOptions far;
   //! Noisy photographs blurred before the whole-pixel image patches read them, just enough to
   //! bring their estimated noise to a reference (stages/flow/image_denoise.h); the surface patches
   //! read them as given (a blur in the image smears an oblique view along the surface), and with

@@ -166,6 +166,10 @@ class Refinement {
       levels_.push_back(half_resolution(level == 0 ? flow_views() : levels_.back()->views));
     if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
     data_.surface_views = surface_views();
+    if (options.far.enabled() && levels_.empty()) {
+      far_images_ = half_resolution(full_views_);  // not the blurred copies (stages/flow/far_vertices.h)
+      data_.far_views = &far_images_->views;
+    }
     // Mask images, when the scene has them, stand for the thresholded photographs everywhere.
     rims_from_masks_ = scene.masks != nullptr;
     const std::vector<Mask> given =
@@ -448,6 +452,8 @@ class Refinement {
     const RefinementResult result = refine_adaptively(mesh_, data_.fields, reference_edge_, options_.adaptive, pixel_size_);
     if (spreads_) extend_reference(reference_, result.parents);
     if (mesh_.n_faces() != faces) {  // a new resolution
+      data_.far_views = nullptr;  // far vertices at the first resolution only (stages/flow/far_vertices.h)
+      far_images_.reset();
       // The added vertices were appended far from their neighbours.
       const std::vector<std::uint32_t> new_of_old = order_vertices_by_locality(mesh_);
       if (spreads_) {
@@ -509,6 +515,7 @@ class Refinement {
     report.sum_g = data_.total.sum_g;
     report.defined_g = data_.total.defined_g;
     report.surface_patch_g = data_.surface_patch_g;
+    report.far_vertices = data_.far_count;
     report.patch_switches = data_.patch_switches;
     report.moving = data_.moving;
     report.shortest_edge = edges.shortest;
@@ -554,6 +561,8 @@ class Refinement {
   //! null otherwise (on a coarser level the halving has averaged the noise for both kinds).
   const std::vector<PhotoView>* surface_views() const { return denoised_ && levels_.empty() ? &full_views_ : nullptr; }
   std::vector<std::unique_ptr<ImageLevel>> levels_;  //!< halved once, twice, ...; dropped as the flow gets there
+  //! The photographs at half resolution that far vertices read (FarVertexOptions), until the first refinement.
+  std::unique_ptr<ImageLevel> far_images_;
   std::vector<PhotoView> views_;       //!< the views the iterations read now (a level's or the full ones)
   TriMesh mesh_;
   IterationData data_;
