@@ -172,6 +172,31 @@ void expect_same_bits(const RefineOptions& options) {
   }
 }
 
+// The far flags change what the next iteration reads: the runs with and without far vertices agree
+// to the bit up to the first iteration that flags one, and Σg differs in the one after.
+TEST(Refiner, FarVerticesReadOtherPhotographsFromTheIterationAfterTheyAreFlagged) {
+  const SmallScene& s = small_scene();
+  RefineOptions with = few_iterations(8);
+  with.far.g_ratio = 3.0;
+  RefineOptions without = with;
+  without.far.g_ratio = 0.0;
+  const RefineResult a = refine_mesh(s.scene, s.initial, with, {});
+  const RefineResult b = refine_mesh(s.scene, s.initial, without, {});
+  ASSERT_NE(a.summary.status, RefineStatus::Failed) << a.summary.message;
+  std::size_t first = a.summary.iterations.size();
+  for (std::size_t i = 0; i < a.summary.iterations.size(); ++i)
+    if (a.summary.iterations[i].far_vertices > 0) {
+      first = i;
+      break;
+    }
+  ASSERT_LT(first + 1, a.summary.iterations.size()) << "no far vertex before the last iteration";
+  for (std::size_t i = 0; i <= first; ++i) {
+    EXPECT_EQ(a.summary.iterations[i].sum_g, b.summary.iterations[i].sum_g) << i;
+    EXPECT_EQ(b.summary.iterations[i].far_vertices, 0u) << i;
+  }
+  EXPECT_NE(a.summary.iterations[first + 1].sum_g, b.summary.iterations[first + 1].sum_g);
+}
+
 TEST(Refiner, SameBitsForThreadsBlockSizesAndEngines) {
   for (const RefineOptions& options : determinism_cases()) expect_same_bits(options);
 }

@@ -149,6 +149,14 @@ TEST(FarVertices, TheMedianIsTakenOverTheNearVerticesOnly) {
   EXPECT_LT(count, s.fields.size());
 }
 
+TEST(FarVertices, AZeroMedianMakesNoVertexFar) {
+  SphereCase s;
+  for (double& g : s.fields.photo_consistency) g = 0.0;  // every patch agrees exactly
+  s.fields.photo_consistency[s.vertex_at_angle(0.0)] = 1.0;
+  std::vector<std::uint8_t> far;
+  EXPECT_EQ(update_far_vertices(s.mesh, s.views, s.fields, FarVertexOptions{}, far), 0u);
+}
+
 TEST(FarVertices, NoVertexWithGLeavesTheFlagsAsTheyAre) {
   SphereCase s;
   for (std::uint8_t& bits : s.fields.defined) bits = 0;

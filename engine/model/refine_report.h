@@ -32,7 +32,8 @@ struct IterationReport {
   std::size_t defined_g = 0;          //!< vertices with defined g
   //! of those, the vertices whose g laid its patch on the surface (PhotoConsistencyOptions::surface_patch)
   std::size_t surface_patch_g = 0;
-  //! The vertices that will read half-resolution photographs in the next iteration (stages/flow/far_vertices.h).
+  //! The far vertices after this iteration's g (stages/flow/far_vertices.h): they read the
+  //! half-resolution photographs in the next iteration unless this one ends the first resolution.
   std::size_t far_vertices = 0;
   //! vertices whose g took the other kind of patch than in the previous iteration of this mesh
   std::size_t patch_switches = 0;

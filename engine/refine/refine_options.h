@@ -85,9 +85,10 @@ struct RefineOptions {
   //! throughout (the thesis). 0..4.
   int image_levels = 0;
   //! Far vertices (stages/flow/far_vertices.h): at the first resolution, a vertex whose g is
-  //! g_ratio × the median reads half-resolution photographs until it comes near. On by default
-  //! (g_ratio 300); off in the thesis preset and whenever image_levels > 0 (every vertex starts
-  //! on coarser images then).
+  //! g_ratio × the median reads half-resolution photographs until it comes near or the first
+  //! resolution ends (when that is the run's last, e.g. --no-adaptive, a far vertex ends on them).
+  //! On by default (g_ratio 300); off in the thesis preset, whenever image_levels > 0 (every
+  //! vertex starts on coarser images then) and when an image is smaller than 16 × 16 pixels.
   FarVertexOptions far;
   //! Noisy photographs blurred before the whole-pixel image patches read them, just enough to
   //! bring their estimated noise to a reference (stages/flow/image_denoise.h); the surface patches

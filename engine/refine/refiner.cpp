@@ -166,7 +166,10 @@ class Refinement {
       levels_.push_back(half_resolution(level == 0 ? flow_views() : levels_.back()->views));
     if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
     data_.surface_views = surface_views();
-    if (options.far.enabled() && levels_.empty()) {
+    // Far vertices need every image halvable (16 × 16 pixels at least); smaller ones run without.
+    const bool halvable = std::all_of(full_views_.begin(), full_views_.end(),
+                                      [](const PhotoView& view) { return view.width >= 16 && view.height >= 16; });
+    if (options.far.enabled() && levels_.empty() && halvable) {
       far_images_ = half_resolution(full_views_);  // not the blurred copies (stages/flow/far_vertices.h)
       data_.far_views = &far_images_->views;
     }

@@ -54,7 +54,7 @@ std::size_t update_far_vertices(const TriMesh& mesh, const std::vector<PhotoView
       const double g = fields.photo_consistency[v];
       if (far[v])
         far[v] = g < near_below ? 0 : 1;
-      else if (g > far_above && seen_frontally(mesh, views, fields, v, min_cos))
+      else if (far_above > 0.0 && g > far_above && seen_frontally(mesh, views, fields, v, min_cos))
         far[v] = 1;
     }
     count += far[v];

@@ -57,10 +57,11 @@ struct FarVertexOptions {
 //! kPhotoDefined): with m the median g over the vertices with g that are not far, a vertex that
 //! is not far becomes far when g > g_ratio·m and one of its visible views (fields.visible, the
 //! camera centres of \p views) lies within view_angle_degrees of its normal; a far vertex is
-//! near again when g < release·g_ratio·m. Vertices without g keep their flag. Serial and in id
-//! order: the flags do not depend on the blocking or the thread count.
+//! near again when g < release·g_ratio·m; while m ≤ 0 (every near vertex's patches agree
+//! exactly) no vertex becomes far. Vertices without g keep their flag. Serial and in id order:
+//! the flags do not depend on the blocking or the thread count.
 //! \param far #V flags (1 = far), resized to #V with zeros when its size differs.
-//! \return the number of far vertices after the update (0 when no vertex has g).
+//! \return the number of far vertices after the update (those kept when no vertex has g).
 //! \throw Error if the fields are not sized for the mesh.
 std::size_t update_far_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views, const VertexFields& fields,
                                 const FarVertexOptions& options, std::vector<std::uint8_t>& far);
