@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include "engine/model/camera.h"
@@ -53,7 +54,7 @@ struct SphereCase {
   double view_angle(std::size_t v) const {
     const Eigen::Vector3d X = to_eigen(mesh.point(TriMesh::VertexHandle(static_cast<int>(v))));
     return std::acos(std::clamp(fields.normal[v].dot((cameras[0].centre() - X).normalized()), -1.0, 1.0)) * 180 /
-           3.14159265358979323846;
+           std::numbers::pi;
   }
   // The vertex whose view angle is closest to \p degrees.
   std::size_t vertex_at_angle(double degrees) const {

@@ -167,9 +167,8 @@ class Refinement {
     if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
     data_.surface_views = surface_views();
     // Far vertices need every image halvable (16 × 16 pixels at least); smaller ones run without.
-    const bool halvable = std::all_of(full_views_.begin(), full_views_.end(),
-                                      [](const PhotoView& view) { return view.width >= 16 && view.height >= 16; });
-    if (options.far.enabled() && levels_.empty() && halvable) {
+    if (options.far.enabled() && levels_.empty() &&
+        std::all_of(full_views_.begin(), full_views_.end(), [](const PhotoView& view) { return halvable(view); })) {
       far_images_ = half_resolution(full_views_);  // not the blurred copies (stages/flow/far_vertices.h)
       data_.far_views = &far_images_->views;
     }

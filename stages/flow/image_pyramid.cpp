@@ -38,7 +38,7 @@ std::unique_ptr<ImageLevel> half_resolution(const std::vector<PhotoView>& views)
   level->cameras.reserve(views.size());
   level->images.reserve(views.size());
   for (const PhotoView& view : views) {
-    MVFLOW_CHECK(view.width >= 16 && view.height >= 16, "image pyramid: an image is too small to halve");
+    MVFLOW_CHECK(halvable(view), "image pyramid: an image is too small to halve");
     level->cameras.push_back(half_camera(*view.camera));
     level->images.push_back(half_image(*view.image));
   }

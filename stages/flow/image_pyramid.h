@@ -36,8 +36,11 @@ Image half_image(const Image& image);
 //! on normalized coordinates).
 Camera half_camera(const Camera& camera);
 
-//! The views of \p views at half the resolution. \throw Error when an image is smaller than
-//! 16 × 16 pixels (a level that small says nothing).
+//! Whether half_resolution takes \p view: its image is at least 16 × 16 pixels (a level smaller
+//! than 8 × 8 says nothing).
+inline bool halvable(const PhotoView& view) { return view.width >= 16 && view.height >= 16; }
+
+//! The views of \p views at half the resolution. \throw Error when an image is not halvable.
 std::unique_ptr<ImageLevel> half_resolution(const std::vector<PhotoView>& views);
 
 }  // namespace mvflow
