@@ -241,6 +241,61 @@ TEST(UnobservedDisplacement, VerticesOnTheSilhouettesCountAsObservedAndAreNotEro
   EXPECT_THROW(poorly_observed_vertices(mesh, views, fields, options, std::vector<std::uint8_t>(3, 0)), Error);
 }
 
+// A region of implausibly high g counts as not observed; a single such vertex does not. The median
+// is the one of the vertices with a speed (40 % of the sphere here; the others' g is 0, so the
+// median over every vertex would be 0 and flag nothing).
+TEST(UnobservedDisplacement, ARegionOfImplausiblyHighGIsNotObserved) {
+  const TriMesh mesh = icosphere(1.0, 3);
+  VertexFields fields = fields_with_speed_above(mesh, 0.2);
+  const auto y = [&](auto v) { return mesh.point(v)[1]; };
+  // The single vertex: the one nearest (0.8, 0.45, 0.4), well outside the cap.
+  TriMesh::VertexHandle single;
+  double nearest = 1e9;
+  for (auto v : mesh.vertices()) {
+    const double d = (to_eigen(mesh.point(v)) - Eigen::Vector3d(0.8, 0.45, 0.4)).norm();
+    if (d < nearest) nearest = d, single = v;
+  }
+  for (auto v : mesh.vertices())
+    if (fields.defined[v.idx()] & kSpeedDefined) fields.photo_consistency[v.idx()] = y(v) > 0.7 || v == single ? 1000.0 : 1.0;
+  std::vector<Camera> cameras = {look_at({0, 5, 0}, {0, 0, 0}, {0, 0, 1}, 60, 64, 48)};
+  std::vector<Image> images(1, Image(64, 48));
+  const std::vector<PhotoView> views = make_photo_views(cameras, {&images[0]});
+  UnobservedDisplacementOptions options;
+  options.erode_rings = 0;
+  options.unobserved_g_ratio = 300.0;
+  const std::vector<std::uint8_t> implausible = implausible_g_vertices(mesh, fields, options.unobserved_g_ratio);
+  const std::vector<std::uint8_t> observed = observed_vertices(mesh, views, fields, options);
+  std::size_t inside_cap = 0;
+  for (auto v : mesh.vertices()) {
+    const auto i = static_cast<std::size_t>(v.idx());
+    // The cap's vertices whose whole ring lies in the cap too.
+    bool ring_in_cap = y(v) > 0.7;
+    for (auto w : mesh.vv_range(v)) ring_in_cap = ring_in_cap && y(w) > 0.7;
+    inside_cap += ring_in_cap;
+    EXPECT_EQ(implausible[i], ring_in_cap ? 1 : 0) << i << " at y = " << y(v);
+    EXPECT_EQ(observed[i], (fields.defined[i] & kSpeedDefined) && !ring_in_cap ? 1 : 0) << i;
+  }
+  EXPECT_GT(inside_cap, 10u);
+  EXPECT_EQ(implausible[static_cast<std::size_t>(single.idx())], 0);
+  // A neighbour without a speed does not count: the ring just outside the cap loses its speeds.
+  VertexFields border = fields;
+  for (auto v : mesh.vertices()) {
+    bool next_to_cap = false;
+    for (auto w : mesh.vv_range(v)) next_to_cap = next_to_cap || y(w) > 0.7;
+    if (y(v) <= 0.7 && next_to_cap) border.defined[v.idx()] &= static_cast<std::uint8_t>(~kSpeedDefined);
+  }
+  const std::vector<std::uint8_t> whole_cap = implausible_g_vertices(mesh, border, 300.0);
+  for (auto v : mesh.vertices()) EXPECT_EQ(whole_cap[v.idx()], y(v) > 0.7 ? 1 : 0) << v.idx();
+  // Off, or a threshold at the cap's g (the default, 1000): nothing.
+  for (const double ratio : {0.0, UnobservedDisplacementOptions{}.unobserved_g_ratio}) {
+    const std::vector<std::uint8_t> none = implausible_g_vertices(mesh, fields, ratio);
+    EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0) << ratio;
+  }
+  options.unobserved_g_ratio = 1.0;
+  EXPECT_THROW(options.check(), Error);
+  EXPECT_THROW(implausible_g_vertices(icosphere(1.0, 1), fields, 300.0), Error);
+}
+
 // Auto without fitted rims spreads only what the flow hardly observed: a vertex stays free when it
 // had a speed in at most fraction × iterations of them (on the boundary, kept).
 TEST(UnobservedDisplacement, HardlyObservedAreThoseWithASpeedInAtMostTheFraction) {

@@ -227,6 +227,10 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(value("--observed-erode", "observed_erode_rings", "unobserved_displacement.erode_rings",
                     "--spread-unobserved: shrink the observed set by this many rings before following it",
                     [](auto& o) -> auto& { return o.unobserved_displacement.erode_rings; }));
+  t.push_back(value("--unobserved-g-ratio", "unobserved_g_ratio", "unobserved_displacement.unobserved_g_ratio",
+                    "--spread-unobserved: a vertex whose g and whose neighbours' g all exceed this multiple of the "
+                    "median g counts as not observed (0 = never, the thesis preset)",
+                    [](auto& o) -> auto& { return o.unobserved_displacement.unobserved_g_ratio; }));
   t.push_back(value("--hardly-observed", "hardly_observed_fraction", "unobserved_displacement.hardly_observed_fraction",
                     "--spread-unobserved auto without fitted rims: only vertices that had a speed in at most this "
                     "fraction of their resolution's iterations follow the observed surface",

@@ -13,6 +13,7 @@
 #include "engine/model/error.h"
 #include "engine/model/option_check.h"
 #include "engine/model/surface_query.h"
+#include "stages/flow/speed.h"  // median_of
 
 namespace mvflow {
 
@@ -24,6 +25,8 @@ void UnobservedDisplacementOptions::check() const {
                  hardly_observed_fraction, "[0, 1]");
   require_option(first_hardly_observed_fraction >= 0 && first_hardly_observed_fraction <= 1,
                  "first_hardly_observed_fraction", first_hardly_observed_fraction, "[0, 1]");
+  require_option(unobserved_g_ratio == 0.0 || (unobserved_g_ratio > 1.0 && std::isfinite(unobserved_g_ratio)),
+                 "unobserved_g_ratio", unobserved_g_ratio, "0 (off) or > 1 and finite");
 }
 
 namespace {
@@ -143,9 +146,10 @@ void observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
   options.check();
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "observed_vertices: fields not sized for the mesh");
   const double cos_observed = std::cos(options.observed_angle_degrees * std::numbers::pi / 180.0);
+  const std::vector<std::uint8_t> implausible = implausible_g_vertices(mesh, fields, options.unobserved_g_ratio);
   observed.assign(fields.size(), 0);
   for (std::uint32_t v = 0; v < fields.size(); ++v) {
-    if (!(fields.defined[v] & kSpeedDefined)) continue;
+    if (!(fields.defined[v] & kSpeedDefined) || implausible[v]) continue;
     if (options.observed_angle_degrees >= 90.0) {
       observed[v] = 1;
       continue;
@@ -159,6 +163,30 @@ void observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
       }
     }
   }
+}
+
+std::vector<std::uint8_t> implausible_g_vertices(const TriMesh& mesh, const VertexFields& fields, double ratio) {
+  MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "implausible_g_vertices: fields not sized for the mesh");
+  const std::size_t n = fields.size();
+  std::vector<std::uint8_t> implausible(n, 0);
+  if (ratio == 0.0) return implausible;
+  std::vector<double> speed_g;
+  speed_g.reserve(n);
+  for (std::size_t v = 0; v < n; ++v)
+    if (fields.defined[v] & kSpeedDefined) speed_g.push_back(fields.photo_consistency[v]);
+  const double above = ratio * median_of(std::move(speed_g));
+  if (!(above > 0.0)) return implausible;
+  std::vector<std::uint8_t> high(n, 0);
+  for (std::size_t v = 0; v < n; ++v)
+    high[v] = (fields.defined[v] & kSpeedDefined) && fields.photo_consistency[v] > above;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!high[v]) continue;
+    bool ring_high = true;
+    for (auto w : mesh.vv_range(TriMesh::VertexHandle(static_cast<int>(v))))
+      if ((fields.defined[w.idx()] & kSpeedDefined) && !high[w.idx()]) ring_high = false;
+    implausible[v] = ring_high;
+  }
+  return implausible;
 }
 
 std::vector<std::uint8_t> poorly_observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
