@@ -102,7 +102,7 @@ std::vector<RefineOptions> determinism_cases() {
   // far, so runs of far and near vertices alternate within every block.
   optional_rules.far.g_ratio = 3.0;
   // ... and vertices not observed where g is high with its ring (3 × the median: many regions).
-  optional_rules.unobserved_displacement.unobserved_g_ratio = 3.0;
+  optional_rules.unobserved_displacement.implausible_g_ratio = 3.0;
   optional_rules.silhouettes.threshold = 0.6;
   // The options for real photographs: coarser images first, speeds filled for unobserved and
   // obliquely seen vertices, outlier views dropped, at most 5 views.

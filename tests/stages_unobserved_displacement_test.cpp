@@ -262,8 +262,8 @@ TEST(UnobservedDisplacement, ARegionOfImplausiblyHighGIsNotObserved) {
   const std::vector<PhotoView> views = make_photo_views(cameras, {&images[0]});
   UnobservedDisplacementOptions options;
   options.erode_rings = 0;
-  options.unobserved_g_ratio = 300.0;
-  const std::vector<std::uint8_t> implausible = implausible_g_vertices(mesh, fields, options.unobserved_g_ratio);
+  options.implausible_g_ratio = 300.0;
+  const std::vector<std::uint8_t> implausible = implausible_g_vertices(mesh, fields, options.implausible_g_ratio);
   const std::vector<std::uint8_t> observed = observed_vertices(mesh, views, fields, options);
   std::size_t inside_cap = 0;
   for (auto v : mesh.vertices()) {
@@ -286,14 +286,15 @@ TEST(UnobservedDisplacement, ARegionOfImplausiblyHighGIsNotObserved) {
   }
   const std::vector<std::uint8_t> whole_cap = implausible_g_vertices(mesh, border, 300.0);
   for (auto v : mesh.vertices()) EXPECT_EQ(whole_cap[v.idx()], y(v) > 0.7 ? 1 : 0) << v.idx();
-  // Off, or a threshold at the cap's g (the default, 1000): nothing.
-  for (const double ratio : {0.0, UnobservedDisplacementOptions{}.unobserved_g_ratio}) {
+  // Off, or a threshold at the cap's g: nothing.
+  for (const double ratio : {0.0, 1000.0}) {
     const std::vector<std::uint8_t> none = implausible_g_vertices(mesh, fields, ratio);
     EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0) << ratio;
   }
-  options.unobserved_g_ratio = 1.0;
+  options.implausible_g_ratio = 1.0;
   EXPECT_THROW(options.check(), Error);
   EXPECT_THROW(implausible_g_vertices(icosphere(1.0, 1), fields, 300.0), Error);
+  EXPECT_THROW(implausible_g_vertices(mesh, fields, 0.5), Error);
 }
 
 // Auto without fitted rims spreads only what the flow hardly observed: a vertex stays free when it

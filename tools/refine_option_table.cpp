@@ -227,10 +227,11 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(value("--observed-erode", "observed_erode_rings", "unobserved_displacement.erode_rings",
                     "--spread-unobserved: shrink the observed set by this many rings before following it",
                     [](auto& o) -> auto& { return o.unobserved_displacement.erode_rings; }));
-  t.push_back(value("--unobserved-g-ratio", "unobserved_g_ratio", "unobserved_displacement.unobserved_g_ratio",
+  t.push_back(value("--implausible-g-ratio", "implausible_g_ratio", "unobserved_displacement.implausible_g_ratio",
                     "--spread-unobserved: a vertex whose g and whose neighbours' g all exceed this multiple of the "
-                    "median g counts as not observed (0 = never, the thesis preset)",
-                    [](auto& o) -> auto& { return o.unobserved_displacement.unobserved_g_ratio; }));
+                    "median g of the vertices with a speed counts as not observed; not applied where the rims are "
+                    "fitted to silhouettes (0 = never, the thesis preset)",
+                    [](auto& o) -> auto& { return o.unobserved_displacement.implausible_g_ratio; }));
   t.push_back(value("--hardly-observed", "hardly_observed_fraction", "unobserved_displacement.hardly_observed_fraction",
                     "--spread-unobserved auto without fitted rims: only vertices that had a speed in at most this "
                     "fraction of their resolution's iterations follow the observed surface",
@@ -241,8 +242,8 @@ std::vector<RefineOptionEntry> make_table() {
                     [](auto& o) -> auto& { return o.unobserved_displacement.first_hardly_observed_fraction; }));
   t.push_back(choice("--spread-unmoved", "spread_unmoved",
                      "--spread-unobserved on/auto: at the run's end the poorly observed vertices the finest resolution "
-                     "never gave a speed follow the observed surface too, and stay: on, off, or auto (where the rims "
-                     "are not fitted)",
+                     "never observed (no speed, or --implausible-g-ratio) follow the observed surface too, and stay: on, "
+                     "off, or auto (where the rims are not fitted)",
                      {{"off", UnobservedSpread::Off}, {"on", UnobservedSpread::On}, {"auto", UnobservedSpread::Auto}},
                      [](auto& o) -> auto& { return o.unobserved_displacement.spread_unmoved; }));
   t.push_back(on_off("--fill-unobserved", "fill_unobserved",

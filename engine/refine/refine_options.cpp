@@ -60,7 +60,7 @@ RefineOptions thesis_preset() {
   options.stopping.test = ConvergenceTest::EachLookback;
   options.rims.fit = RimFit::Off;
   options.unobserved_displacement.spread = UnobservedSpread::Off;
-  options.unobserved_displacement.unobserved_g_ratio = 0.0;
+  options.unobserved_displacement.implausible_g_ratio = 0.0;
   options.photo.photo.surface_patch = SurfacePatchUse::Off;
   options.denoise.use = DenoiseUse::Off;
   options.far.g_ratio = 0.0;

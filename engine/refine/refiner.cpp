@@ -190,9 +190,9 @@ class Refinement {
     }
     spreads_hardly_observed_ = options.unobserved_displacement.spread == UnobservedSpread::Auto && !data_.rim_masks;
     // Implausibly high g marks the background showing through; where the rims are fitted the
-    // silhouettes hold the outline (UnobservedDisplacementOptions::unobserved_g_ratio).
+    // silhouettes hold the outline (UnobservedDisplacementOptions::implausible_g_ratio).
     observed_options_ = options.unobserved_displacement;
-    if (data_.rim_masks) observed_options_.unobserved_g_ratio = 0.0;
+    if (data_.rim_masks) observed_options_.implausible_g_ratio = 0.0;
     const UnobservedSpread unmoved = options.unobserved_displacement.spread_unmoved;
     spreads_unmoved_ =
         spreads_ && (unmoved == UnobservedSpread::On || (unmoved == UnobservedSpread::Auto && !data_.rim_masks));
@@ -586,7 +586,7 @@ class Refinement {
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the hardly observed (the spread is auto without rims: spread_fraction()).
   bool spreads_hardly_observed_ = false;
-  //! The unobserved spread's options as applied: no unobserved_g_ratio where the rims are fitted.
+  //! The unobserved spread's options as applied: no implausible_g_ratio where the rims are fitted.
   UnobservedDisplacementOptions observed_options_;
   std::vector<std::uint32_t> speed_iterations_;  //!< per vertex, iterations at this resolution with a speed
   std::vector<std::uint8_t> observed_;            //!< count_observed()'s flags of the last iteration, reused

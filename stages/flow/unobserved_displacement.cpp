@@ -25,8 +25,8 @@ void UnobservedDisplacementOptions::check() const {
                  hardly_observed_fraction, "[0, 1]");
   require_option(first_hardly_observed_fraction >= 0 && first_hardly_observed_fraction <= 1,
                  "first_hardly_observed_fraction", first_hardly_observed_fraction, "[0, 1]");
-  require_option(unobserved_g_ratio == 0.0 || (unobserved_g_ratio > 1.0 && std::isfinite(unobserved_g_ratio)),
-                 "unobserved_g_ratio", unobserved_g_ratio, "0 (off) or > 1 and finite");
+  require_option(implausible_g_ratio == 0.0 || (implausible_g_ratio > 1.0 && std::isfinite(implausible_g_ratio)),
+                 "implausible_g_ratio", implausible_g_ratio, "0 (off) or > 1 and finite");
 }
 
 namespace {
@@ -146,7 +146,7 @@ void observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
   options.check();
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "observed_vertices: fields not sized for the mesh");
   const double cos_observed = std::cos(options.observed_angle_degrees * std::numbers::pi / 180.0);
-  const std::vector<std::uint8_t> implausible = implausible_g_vertices(mesh, fields, options.unobserved_g_ratio);
+  const std::vector<std::uint8_t> implausible = implausible_g_vertices(mesh, fields, options.implausible_g_ratio);
   observed.assign(fields.size(), 0);
   for (std::uint32_t v = 0; v < fields.size(); ++v) {
     if (!(fields.defined[v] & kSpeedDefined) || implausible[v]) continue;
@@ -167,6 +167,7 @@ void observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
 
 std::vector<std::uint8_t> implausible_g_vertices(const TriMesh& mesh, const VertexFields& fields, double ratio) {
   MVFLOW_CHECK(fields.size() == mesh.n_vertices(), "implausible_g_vertices: fields not sized for the mesh");
+  MVFLOW_CHECK(ratio == 0.0 || (ratio > 1.0 && std::isfinite(ratio)), "implausible_g_vertices: ratio must be 0 or > 1");
   const std::size_t n = fields.size();
   std::vector<std::uint8_t> implausible(n, 0);
   if (ratio == 0.0) return implausible;

@@ -52,8 +52,9 @@ struct UnobservedDisplacementOptions {
   //! +3.4 %, 1: 0.946 with it +19.5 %), and on six scenes used for no choice 0.986× (README,
   //! "Weakly seen regions"). [0, 1].
   double first_hardly_observed_fraction = 0.75;
-  //! At the end of the run (after the finest resolution), the poorly observed vertices that had
-  //! no speed in any iteration of that resolution follow the observed surface too, and stay: the
+  //! At the end of the run (after the finest resolution), the poorly observed vertices that were
+  //! observed in no iteration of that resolution (no speed, or implausibly high g with their ring
+  //! in every one: implausible_g_ratio) follow the observed surface too, and stay: the
   //! flow never moved them there, so the spread cannot undo what it recovered, and without it
   //! such a region keeps the error of the last coarser level while its observed border goes on
   //! converging. Auto (the default): where the rims are not fitted. On the fifteen textured
@@ -77,22 +78,23 @@ struct UnobservedDisplacementOptions {
   //! iteration: a region whose patches agree in no view (the background or an occluder shows
   //! through: no surface there to follow), which the flow leaves only by creeping (t2's peanut
   //! waist, top and bottom, 0.1 outside the truth with g 2000–2600× the median). A single such vertex
-  //! amid ordinary ones (a grazing spot on a sphere) stays observed: without the neighbour
+  //! amid ordinary ones (a grazing spot on a sphere) stays observed (one whose neighbours all lack
+  //! a speed is not: its ring is unobserved already): without the neighbour
   //! condition (at 300×) the bumpy sphere lost 16 %. 1000: over 32 scenes × 3 runs 0.979× the
   //! error (t2 0.660, w4 0.776), issue 12's item 5 on all 36 sphere runs, the longest run 137
   //! iterations; 300: 0.969× but item 5 on 35, one run at the budget and 6 scenes worse by > 3 %
   //! (README, "Weakly seen regions"). The refiner does not apply it where the rims are fitted to
-  //! silhouettes: they hold the outline there, and a dark background does not raise g (dino's
+  //! silhouettes (a dark background, or mask files): they hold the outline there (dino's
   //! held-out gain −30.9 → −30.2 % with it, the temple's unchanged). 0 turns it off (the thesis
   //! preset); else > 1.
-  double unobserved_g_ratio = 1000.0;
+  double implausible_g_ratio = 1000.0;
 
   //! \throw OptionError naming the first field out of range, its value and its valid values.
   void check() const;
 };
 
 //! One flag per vertex: 1 when the last iteration gave it a speed (kSpeedDefined), it is not
-//! one of implausible_g_vertices(mesh, fields, options.unobserved_g_ratio) and, with
+//! one of implausible_g_vertices(mesh, fields, options.implausible_g_ratio) and, with
 //! options.observed_angle_degrees < 90, one of the views in fields.visible(v) lies within that
 //! angle of fields.normal[v]; 0 otherwise.
 //! \throw Error if the options are invalid or the fields are not sized for the mesh.
@@ -106,7 +108,7 @@ void observed_vertices(const TriMesh& mesh, const std::vector<PhotoView>& views,
 
 //! One flag per vertex: 1 when the vertex has a speed (kSpeedDefined) and g above \p ratio times the
 //! median g of the vertices with a speed, and so has every neighbour with a speed
-//! (UnobservedDisplacementOptions::unobserved_g_ratio); all 0 when \p ratio is 0 or that median is 0.
+//! (UnobservedDisplacementOptions::implausible_g_ratio); all 0 when \p ratio is 0 or that median is 0.
 //! \throw Error if the fields are not sized for the mesh.
 std::vector<std::uint8_t> implausible_g_vertices(const TriMesh& mesh, const VertexFields& fields, double ratio);
 
