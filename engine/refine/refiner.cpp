@@ -189,10 +189,6 @@ class Refinement {
       data_.rim_views = &full_views_;
     }
     spreads_hardly_observed_ = options.unobserved_displacement.spread == UnobservedSpread::Auto && !data_.rim_masks;
-    // Implausibly high g marks the background showing through; where the rims are fitted the
-    // silhouettes hold the outline (UnobservedDisplacementOptions::implausible_g_ratio).
-    observed_options_ = options.unobserved_displacement;
-    if (data_.rim_masks) observed_options_.implausible_g_ratio = 0.0;
     const UnobservedSpread unmoved = options.unobserved_displacement.spread_unmoved;
     spreads_unmoved_ =
         spreads_ && (unmoved == UnobservedSpread::On || (unmoved == UnobservedSpread::Auto && !data_.rim_masks));
@@ -385,11 +381,20 @@ class Refinement {
     return first ? options_.unobserved_displacement.first_hardly_observed_fraction : spread_fraction();
   }
 
+  // The unobserved spread's options as applied. Implausibly high g marks the background showing
+  // through; where the rims are fitted the silhouettes hold the outline, so not there
+  // (UnobservedDisplacementOptions::implausible_g_ratio).
+  UnobservedDisplacementOptions observed_options() const {
+    UnobservedDisplacementOptions options = options_.unobserved_displacement;
+    if (data_.rim_masks) options.implausible_g_ratio = 0.0;
+    return options;
+  }
+
   // One more iteration at this resolution, and which vertices had a speed in it.
   void count_observed() {
     if (!spreads_) return;
     ++level_iterations_;
-    observed_vertices(mesh_, views_, data_.fields, observed_options_, observed_);
+    observed_vertices(mesh_, views_, data_.fields, observed_options(), observed_);
     for (std::size_t v = 0; v < speed_iterations_.size(); ++v) speed_iterations_[v] += observed_[v];
   }
 
@@ -426,7 +431,7 @@ class Refinement {
   bool spread_unobserved(double fraction) {
     if (!spreads_) return false;
     std::vector<std::uint8_t> poor =
-        poorly_observed_vertices(mesh_, views_, data_.fields, observed_options_, data_.on_rim);
+        poorly_observed_vertices(mesh_, views_, data_.fields, observed_options(), data_.on_rim);
     // Kept among those after their erosion: growing the hardly observed set by the ring instead
     // spread more of a bumpy object's underside (bumpy sphere 0.00173 → 0.00241).
     if (fraction < 1) keep_hardly_observed(poor, speed_iterations_, level_iterations_, fraction);
@@ -586,8 +591,6 @@ class Refinement {
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the hardly observed (the spread is auto without rims: spread_fraction()).
   bool spreads_hardly_observed_ = false;
-  //! The unobserved spread's options as applied: no implausible_g_ratio where the rims are fitted.
-  UnobservedDisplacementOptions observed_options_;
   std::vector<std::uint32_t> speed_iterations_;  //!< per vertex, iterations at this resolution with a speed
   std::vector<std::uint8_t> observed_;            //!< count_observed()'s flags of the last iteration, reused
   int level_iterations_ = 0;                      //!< iterations at this resolution

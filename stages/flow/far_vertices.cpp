@@ -5,7 +5,7 @@
 
 #include "engine/model/error.h"
 #include "engine/model/option_check.h"
-#include "stages/flow/speed.h"  // median_of
+#include "stages/flow/speed.h"  // median_g_where
 
 namespace mvflow {
 
@@ -37,18 +37,12 @@ std::size_t update_far_vertices(const TriMesh& mesh, const std::vector<PhotoView
   const std::size_t n = mesh.n_vertices();
   MVFLOW_CHECK(fields.size() == n, "update_far_vertices: the fields are not sized for the mesh");
   if (far.size() != n) far.assign(n, 0);
-  std::vector<double> near_g;
-  near_g.reserve(n);
-  for (std::size_t v = 0; v < n; ++v)
-    if ((fields.defined[v] & kPhotoDefined) && !far[v]) near_g.push_back(fields.photo_consistency[v]);
-  std::size_t count = 0;
-  if (near_g.empty()) {
-    for (const std::uint8_t flag : far) count += flag;
-    return count;
-  }
-  const double far_above = options.g_ratio * median_of(std::move(near_g));
+  // With no near vertex with g the median is 0: no vertex becomes far and none is released (g ≥ 0).
+  const double far_above =
+      options.g_ratio * median_g_where(fields, [&](std::size_t v) { return (fields.defined[v] & kPhotoDefined) && !far[v]; });
   const double near_below = options.release * far_above;
   const double min_cos = std::cos(options.view_angle_degrees * std::numbers::pi / 180.0);
+  std::size_t count = 0;
   for (std::size_t v = 0; v < n; ++v) {
     if (fields.defined[v] & kPhotoDefined) {
       const double g = fields.photo_consistency[v];

@@ -97,6 +97,18 @@ double median_speed(const TriMesh& mesh, const VertexFields& fields);
 //! The median of \p values (the mean of the two middle ones for an even count); 0 when empty.
 double median_of(std::vector<double> values);
 
+//! median_of the g (fields.photo_consistency) of the vertices v, in id order, for which
+//! \p counts(v) is true; 0 when there is none. The far-vertex and implausible-g rules take
+//! their thresholds from it.
+template <typename Counts>
+double median_g_where(const VertexFields& fields, Counts counts) {
+  std::vector<double> g;
+  g.reserve(fields.size());
+  for (std::size_t v = 0; v < fields.size(); ++v)
+    if (counts(v)) g.push_back(fields.photo_consistency[v]);
+  return median_of(std::move(g));
+}
+
 //! The \p quantile (in (0, 1]; 1 = the maximum) of |F| over the moving vertices, the value at
 //! rank ceil(quantile·n) − 1 of the sorted speeds; 0 if none move. Allocates one buffer.
 double speed_quantile(const TriMesh& mesh, const VertexFields& fields, double quantile);

@@ -13,7 +13,7 @@
 #include "engine/model/error.h"
 #include "engine/model/option_check.h"
 #include "engine/model/surface_query.h"
-#include "stages/flow/speed.h"  // median_of
+#include "stages/flow/speed.h"  // median_g_where
 
 namespace mvflow {
 
@@ -171,11 +171,7 @@ std::vector<std::uint8_t> implausible_g_vertices(const TriMesh& mesh, const Vert
   const std::size_t n = fields.size();
   std::vector<std::uint8_t> implausible(n, 0);
   if (ratio == 0.0) return implausible;
-  std::vector<double> speed_g;
-  speed_g.reserve(n);
-  for (std::size_t v = 0; v < n; ++v)
-    if (fields.defined[v] & kSpeedDefined) speed_g.push_back(fields.photo_consistency[v]);
-  const double above = ratio * median_of(std::move(speed_g));
+  const double above = ratio * median_g_where(fields, [&](std::size_t v) { return (fields.defined[v] & kSpeedDefined) != 0; });
   if (!(above > 0.0)) return implausible;
   std::vector<std::uint8_t> high(n, 0);
   for (std::size_t v = 0; v < n; ++v)
