@@ -2,6 +2,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -180,7 +183,34 @@ std::optional<RayHit> SurfaceQuery::intersect(const Eigen::Vector3d& origin, con
   query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(embree_->scene, &context, &query);
   if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-  return RayHit{query.ray.tfar, query.hit.primID, Eigen::Vector2d(query.hit.u, query.hit.v)};
+  const RayHit found{query.ray.tfar, query.hit.primID, Eigen::Vector2d(query.hit.u, query.hit.v)};
+  const auto& triangle = triangles_[found.face];
+  return hit_in_double(origin, direction, positions_[triangle[0]], positions_[triangle[1]], positions_[triangle[2]],
+                       found);
+}
+
+RayHit hit_in_double(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, const Eigen::Vector3d& a,
+                     const Eigen::Vector3d& b, const Eigen::Vector3d& c, const RayHit& found) {
+  // Möller–Trumbore on the double positions: only IEEE operations in one fixed order (no
+  // reciprocal approximations, no contraction), so the same bits on every CPU.
+  const Eigen::Vector3d e1 = b - a, e2 = c - a;
+  const Eigen::Vector3d p = direction.cross(e2);
+  const double det = e1.dot(p);
+  if (!(std::abs(det) > 0.0)) return found;  // parallel in double: Embree's float answer stands
+  const Eigen::Vector3d s = origin - a;
+  const Eigen::Vector3d q = s.cross(e1);
+  double u = s.dot(p) / det, v = direction.dot(q) / det;
+  const double t = e2.dot(q) / det;
+  if (!std::isfinite(u) || !std::isfinite(v) || !std::isfinite(t)) return found;
+  // Embree's float test accepted the face; a hit on its edge may land a rounding outside in double.
+  u = std::clamp(u, 0.0, 1.0);
+  v = std::clamp(v, 0.0, 1.0);
+  if (u + v > 1.0) {
+    const double sum = u + v;
+    u /= sum;
+    v /= sum;
+  }
+  return RayHit{t, found.face, Eigen::Vector2d(u, v)};
 }
 
 ClosestPoint SurfaceQuery::closest_point(const Eigen::Vector3d& point) const {

@@ -23,8 +23,17 @@ namespace mvflow {
 struct RayHit {
   double distance = 0.0;         //!< along the (unit) ray direction
   std::uint32_t face = 0;        //!< face id
-  Eigen::Vector2d barycentric;   //!< Embree's (u, v): point = (1−u−v)·P0 + u·P1 + v·P2
+  Eigen::Vector2d barycentric;   //!< (u, v) as Embree's: point = (1−u−v)·P0 + u·P1 + v·P2
 };
+
+//! The hit of the ray on triangle (a, b, c), which Embree \p found, recomputed in double
+//! precision: its distance and barycentric coordinates (clamped into the triangle), the face
+//! kept. Embree's float answer depends on its instruction-set path and on the CPU's reciprocal
+//! approximation (which may differ between CPU makers), and the synthetic renders and the
+//! held-out renders shade it; this one is the same bits on every CPU. \p found itself when the ray is
+//! parallel to the triangle in double.
+RayHit hit_in_double(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, const Eigen::Vector3d& a,
+                     const Eigen::Vector3d& b, const Eigen::Vector3d& c, const RayHit& found);
 
 //! The point of the surface nearest to a query point (exact, in double precision).
 struct ClosestPoint {
@@ -61,7 +70,8 @@ class SurfaceQuery {
   //! True when the segment origin + t·direction, t in (t_near, t_far), hits the surface.
   //! \p direction need not be unit length; t is in its units.
   bool occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double t_near, double t_far) const;
-  //! The first hit along the ray with unit-length \p direction, if any.
+  //! The first hit along the ray with unit-length \p direction, if any: the face Embree finds,
+  //! its distance and barycentric coordinates from hit_in_double (the same bits on every CPU).
   std::optional<RayHit> intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                                   double t_near = 0.0,
                                   double t_far = std::numeric_limits<double>::infinity()) const;
