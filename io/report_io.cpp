@@ -22,6 +22,7 @@ nlohmann::json iteration_json(const IterationReport& r) {
           {"surface_patch_g", r.surface_patch_g},
           {"patch_switches", r.patch_switches},
           {"far_vertices", r.far_vertices},
+          {"implausible_g", r.implausible_g},
           {"moving_vertices", r.moving},
           {"shortest_edge", r.shortest_edge},
           {"max_speed", r.max_speed},

@@ -47,6 +47,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--observed-view-angle", {"60", 60.0}},
       {"--observed-erode", {"2", 2}},
       {"--implausible-g-ratio", {"40", 40.0}},
+      {"--implausible-speed-rings", {"3", 3}},
       {"--hardly-observed", {"0.4", 0.4}},
       {"--hardly-observed-first", {"0.5", 0.5}},
       {"--spread-unmoved", {"on", "on"}},
@@ -160,7 +161,7 @@ TEST(RefineOptionTable, EachFlagSetsItsOwnFieldAndNothingElse) {
 TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
-        {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--implausible-g-ratio", "1"}, {"--hardly-observed", "1.5"},
+        {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--implausible-g-ratio", "1"}, {"--implausible-speed-rings", "17"}, {"--hardly-observed", "1.5"},
         {"--hardly-observed-first", "-0.1"}, {"--settle-noise-reference", "-0.001"},
         {"--denoise", "on"}, {"--denoise-reference", "0"}, {"--momentum", "1"},
         {"--far-g-ratio", "0.5"}, {"--far-view-angle", "0"}, {"--far-release", "2"}}) {

@@ -155,6 +155,11 @@ void expect_same_bits(const RefineOptions& options) {
     }
     EXPECT_GT(far, 0u) << "the case must exercise far vertices";
   }
+  if (options.unobserved_displacement.implausible_g_ratio > 0.0 && options.unobserved_displacement.implausible_g_ratio < 10.0) {
+    std::size_t implausible = 0;
+    for (const IterationReport& r : reference.summary.iterations) implausible += r.implausible_g;
+    EXPECT_GT(implausible, 0u) << "the case must exercise the implausible-g rule";
+  }
   for (const RefineResult* other : {&single, &blocks, &plain}) {
     ASSERT_EQ(other->summary.iterations.size(), reference.summary.iterations.size());
     EXPECT_EQ(positions(*other), positions(reference));  // exact, not approximate
@@ -165,6 +170,7 @@ void expect_same_bits(const RefineOptions& options) {
       EXPECT_EQ(other->summary.iterations[i].surface_patch_g, reference.summary.iterations[i].surface_patch_g);
       EXPECT_EQ(other->summary.iterations[i].patch_switches, reference.summary.iterations[i].patch_switches);
       EXPECT_EQ(other->summary.iterations[i].far_vertices, reference.summary.iterations[i].far_vertices);
+      EXPECT_EQ(other->summary.iterations[i].implausible_g, reference.summary.iterations[i].implausible_g);
       // NaN in the first iterations of each topology: compared as bits.
       EXPECT_EQ(std::bit_cast<std::uint64_t>(other->summary.iterations[i].net_move),
                 std::bit_cast<std::uint64_t>(reference.summary.iterations[i].net_move));
@@ -172,6 +178,28 @@ void expect_same_bits(const RefineOptions& options) {
                 std::bit_cast<std::uint64_t>(reference.summary.iterations[i].net_move_tail));
     }
   }
+}
+
+// The implausible-g rule reports the vertices it takes for the background showing through, and
+// is off where the rims are fitted to silhouettes (they hold the outline there) or at ratio 0.
+TEST(Refiner, ReportsImplausibleGVerticesOnlyWhereTheRimsAreNotFitted) {
+  const SmallScene& s = small_scene();
+  const auto implausible_in = [&](double ratio, RimFit fit) {
+    RefineOptions options = few_iterations(8);
+    options.unobserved_displacement.implausible_g_ratio = ratio;
+    options.rims.fit = fit;
+    const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
+    EXPECT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+    std::size_t total = 0;
+    for (const IterationReport& r : result.summary.iterations) {
+      EXPECT_LE(r.implausible_g, r.moving) << r.iteration;  // only vertices with a speed
+      total += r.implausible_g;
+    }
+    return total;
+  };
+  EXPECT_GT(implausible_in(3.0, RimFit::Off), 0u);  // 3 × the median: many regions of the textured background
+  EXPECT_EQ(implausible_in(3.0, RimFit::On), 0u);
+  EXPECT_EQ(implausible_in(0.0, RimFit::Off), 0u);
 }
 
 // The far flags change what the next iteration reads: the runs with and without far vertices agree

@@ -35,6 +35,11 @@ struct IterationReport {
   //! The far vertices after this iteration's g (stages/flow/far_vertices.h): they read the
   //! half-resolution photographs in the next iteration unless this one ends the first resolution.
   std::size_t far_vertices = 0;
+  //! The vertices with a speed whose g is implausibly high with their ring
+  //! (UnobservedDisplacementOptions::implausible_g_ratio): their speeds are averaged
+  //! (ImplausibleSpeedOptions) and the unobserved spread counts them as not observed. 0 where the
+  //! rims are fitted to silhouettes (the rule is off there) or the ratio is 0.
+  std::size_t implausible_g = 0;
   //! vertices whose g took the other kind of patch than in the previous iteration of this mesh
   std::size_t patch_switches = 0;
   std::size_t moving = 0;             //!< vertices with a defined speed

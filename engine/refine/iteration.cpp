@@ -12,11 +12,13 @@
 #include "stages/flow/commit.h"
 #include "stages/flow/curvature.h"
 #include "stages/flow/far_vertices.h"
+#include "stages/flow/implausible_speed.h"
 #include "stages/flow/normals.h"
 #include "stages/flow/photo_robust.h"
 #include "stages/flow/regularization.h"
 #include "stages/flow/silhouette_rims.h"
 #include "stages/flow/smoothing.h"
+#include "stages/flow/unobserved_displacement.h"
 #include "stages/flow/unobserved_speed.h"
 #include "stages/flow/visibility.h"
 
@@ -177,6 +179,18 @@ void IterationData::cfl() {
   }
   total.sum_g = sum_g;
   far_count = far_views != nullptr ? update_far_vertices(mesh, views, fields, options.far, far) : 0;
+  // Where the background shows through, the speed's sign is noise; the region moves by its mean.
+  implausible_count = 0;
+  if (options.unobserved_displacement.implausible_g_ratio > 0.0 && rim_masks == nullptr) {
+    const std::vector<std::uint8_t> implausible =
+        implausible_g_vertices(mesh, fields, options.unobserved_displacement.implausible_g_ratio);
+    for (const std::uint8_t flag : implausible) implausible_count += flag;
+    if (average_implausible_speeds(mesh, implausible, options.implausible_speed, fields) > 0) {
+      total.max_speed = 0.0;
+      for (std::size_t v = 0; v < fields.size(); ++v)
+        if (fields.defined[v] & kSpeedDefined) total.max_speed = std::max(total.max_speed, fields.speed[v].norm());
+    }
+  }
   // Before the step: weakly seen vertices only follow it, so they leave the maximum too.
   if (demote_weakly_seen(mesh, views, options.unobserved, fields) > 0) {
     total.max_speed = 0.0;

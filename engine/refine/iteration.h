@@ -97,6 +97,9 @@ struct IterationData {
   std::size_t patch_switches = 0;
   std::size_t moving = 0;
   std::size_t far_count = 0;  //!< set by cfl(): the far vertices for the next iteration (0 without far_views)
+  //! set by cfl(): the vertices of implausibly high g with their ring (implausible_g_vertices; 0
+  //! where the rule is off or the rims are fitted), whose speeds it averaged (ImplausibleSpeedOptions)
+  std::size_t implausible_count = 0;
   double serial_seconds[kStageCount] = {};
 
   //! Sizes everything for the mesh's current topology (new blocks, fields, Embree scene).

@@ -13,6 +13,7 @@ void RefineOptions::check() const {
   check_member(visibility, "visibility");
   check_member(unobserved, "unobserved");
   check_member(unobserved_displacement, "unobserved_displacement");
+  check_member(implausible_speed, "implausible_speed");
   check_member(speed, "speed");
   require_option(cfl > 0 && cfl <= 10, "cfl", cfl, "(0, 10]");
   require_option(speed_quantile > 0 && speed_quantile <= 1, "speed_quantile", speed_quantile, "(0, 1]");
@@ -61,6 +62,7 @@ RefineOptions thesis_preset() {
   options.rims.fit = RimFit::Off;
   options.unobserved_displacement.spread = UnobservedSpread::Off;
   options.unobserved_displacement.implausible_g_ratio = 0.0;
+  options.implausible_speed.rings = 0;
   options.photo.photo.surface_patch = SurfacePatchUse::Off;
   options.denoise.use = DenoiseUse::Off;
   options.far.g_ratio = 0.0;

@@ -10,6 +10,7 @@
 #include "stages/flow/curvature.h"
 #include "stages/flow/far_vertices.h"
 #include "stages/flow/image_denoise.h"
+#include "stages/flow/implausible_speed.h"
 #include "stages/flow/photo_gradient.h"
 #include "stages/flow/regularization.h"
 #include "stages/topology/remeshing.h"
@@ -53,6 +54,9 @@ struct RefineOptions {
   //! Whether the poorly observed vertices take the observed surface's displacement when the
   //! flow has converged at a resolution and at the end (default: yes; thesis preset: no).
   UnobservedDisplacementOptions unobserved_displacement;
+  //! The speed of a region of implausibly high g (unobserved_displacement.implausible_g_ratio,
+  //! where the rims are not fitted) averaged over its rings (default: 8 rings; thesis preset: off).
+  ImplausibleSpeedOptions implausible_speed;
   //! Δt = cfl·(e/2)/(√3·|F|_q), e the mean edge (local_step) or e_min (SPEC §4; thesis 1)
   double cfl = 1.0;
   //! q, the quantile of |F| over the moving vertices that sets Δt; in (0, 1]. 1 = max|F|, the
