@@ -170,10 +170,11 @@ TEST(SurfaceQuery, TracesEveryRayByEmbreesAvx2Path) {
 }
 
 // The synthetic and held-out renders shade the hit's barycentrics: Embree's float ones differed
-// in their last bits between its SSE2 and AVX2 paths (6 of 921 600 pixel values of the quick start's
-// first view by one level), and its AVX2 path's reciprocals between AMD and Intel CPUs (the quick
-// start ended at 5835 vertices on a Zen 4, 5858 on a Xeon). Recomputed in double they are the
-// same bits whichever path found the face.
+// in their last bits between its SSE2 and AVX2 paths (the quick start's 16 views: 190 of 14.7
+// million values), and the quick start ended at 5835 vertices on a Zen 4, 5858 on a Xeon (its AVX2
+// path's reciprocal). Recomputed in double they are the same bits whichever path found the face.
+// On a CPU whose paths agree anyway this passes without the recomputation; HitInDouble tests it
+// directly.
 TEST(SurfaceQuery, RayHitsAreTheSameBitsWhateverEmbreesInstructionSet) {
   const IndexedMesh mesh = make_icosphere(1.0, 4);
   const SurfaceQuery sse2(mesh, "max_isa=sse2"), avx2(mesh, "max_isa=avx2"), widest(mesh, "");
@@ -196,6 +197,27 @@ TEST(SurfaceQuery, RayHitsAreTheSameBitsWhateverEmbreesInstructionSet) {
   }
   EXPECT_GT(hits, rays / 2);
   EXPECT_LT(other_face, rays / 1000);
+}
+
+// hit_in_double by hand on the triangle (0,0,0), (1,0,0), (0,1,0): Embree's float answer is
+// replaced whatever it was; a hit a rounding outside the triangle is clamped into it, its
+// distance into the range searched; a ray parallel to the plane keeps Embree's answer.
+TEST(HitInDouble, RecomputesClampsAndFallsBack) {
+  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), down(0, 0, -1);
+  const RayHit embree{2.0000001, 7, Eigen::Vector2d(0.25000003, 0.5)}, other{1.9999999, 7, Eigen::Vector2d(0.2499999, 0.5)};
+  const RayHit hit = hit_in_double({0.25, 0.5, 2}, down, a, b, c, embree);
+  EXPECT_TRUE(same_bits(hit, hit_in_double({0.25, 0.5, 2}, down, a, b, c, other)));
+  EXPECT_EQ(hit.distance, 2.0);
+  EXPECT_EQ(hit.face, 7u);
+  EXPECT_EQ(hit.barycentric, Eigen::Vector2d(0.25, 0.5));
+  // Beyond the hypotenuse: (0.6, 0.6) scaled back onto it; left of the y axis: u clamped to 0.
+  EXPECT_EQ(hit_in_double({0.6, 0.6, 1}, down, a, b, c, embree).barycentric, Eigen::Vector2d(0.5, 0.5));
+  EXPECT_EQ(hit_in_double({-0.01, 0.5, 1}, down, a, b, c, embree).barycentric, Eigen::Vector2d(0.0, 0.5));
+  // The distance stays in [t_near, t_far].
+  EXPECT_EQ(hit_in_double({0.25, 0.5, 2}, down, a, b, c, embree, 0.0, 1.5).distance, 1.5);
+  EXPECT_EQ(hit_in_double({0.25, 0.5, -0.5}, down, a, b, c, embree).distance, 0.0);
+  // Parallel to the plane: Embree's answer stands.
+  EXPECT_TRUE(same_bits(hit_in_double({0.25, 0.5, 0}, Eigen::Vector3d(1, 0, 0), a, b, c, embree), embree));
 }
 
 }  // namespace

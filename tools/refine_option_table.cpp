@@ -227,15 +227,17 @@ std::vector<RefineOptionEntry> make_table() {
   t.push_back(value("--observed-erode", "observed_erode_rings", "unobserved_displacement.erode_rings",
                     "--spread-unobserved: shrink the observed set by this many rings before following it",
                     [](auto& o) -> auto& { return o.unobserved_displacement.erode_rings; }));
-  t.push_back(value("--implausible-speed-rings", "implausible_speed_rings", "implausible_speed.rings",
-                    "the speed of a vertex of implausibly high g (--implausible-g-ratio) becomes the mean over "
-                    "this many rings around it, rounds of one-ring means (0 = its own, the thesis preset)",
-                    [](auto& o) -> auto& { return o.implausible_speed.rings; }));
   t.push_back(value("--implausible-g-ratio", "implausible_g_ratio", "unobserved_displacement.implausible_g_ratio",
-                    "--spread-unobserved: a vertex whose g and whose neighbours' g all exceed this multiple of the "
-                    "median g of the vertices with a speed counts as not observed; not applied where the rims are "
-                    "fitted to silhouettes (0 = never, the thesis preset)",
+                    "a vertex whose g and whose neighbours' g all exceed this multiple of the median g of the "
+                    "vertices with a speed counts as not observed by --spread-unobserved, and its speed is averaged "
+                    "(--implausible-speed-rings); not applied where the rims are fitted to silhouettes (0 = never, "
+                    "the thesis preset)",
                     [](auto& o) -> auto& { return o.unobserved_displacement.implausible_g_ratio; }));
+  t.push_back(value("--implausible-speed-rings", "implausible_speed_rings", "implausible_speed.rings",
+                    "the speed of a vertex of implausibly high g (--implausible-g-ratio) becomes this many rounds "
+                    "of one-ring means over the vertices with a speed; not where the rims are fitted (0 = its own, "
+                    "the thesis preset)",
+                    [](auto& o) -> auto& { return o.implausible_speed.rings; }));
   t.push_back(value("--hardly-observed", "hardly_observed_fraction", "unobserved_displacement.hardly_observed_fraction",
                     "--spread-unobserved auto without fitted rims: only vertices that had a speed in at most this "
                     "fraction of their resolution's iterations follow the observed surface",

@@ -186,13 +186,15 @@ std::optional<RayHit> SurfaceQuery::intersect(const Eigen::Vector3d& origin, con
   const RayHit found{query.ray.tfar, query.hit.primID, Eigen::Vector2d(query.hit.u, query.hit.v)};
   const auto& triangle = triangles_[found.face];
   return hit_in_double(origin, direction, positions_[triangle[0]], positions_[triangle[1]], positions_[triangle[2]],
-                       found);
+                       found, t_near, t_far);
 }
 
 RayHit hit_in_double(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, const Eigen::Vector3d& a,
-                     const Eigen::Vector3d& b, const Eigen::Vector3d& c, const RayHit& found) {
+                     const Eigen::Vector3d& b, const Eigen::Vector3d& c, const RayHit& found, double t_near,
+                     double t_far) {
   // Möller–Trumbore on the double positions: only IEEE operations in one fixed order (no
-  // reciprocal approximations, no contraction), so the same bits on every CPU.
+  // reciprocal approximation, and no fused multiply-add: the build sets -ffp-contract=off), so
+  // the same bits on every CPU.
   const Eigen::Vector3d e1 = b - a, e2 = c - a;
   const Eigen::Vector3d p = direction.cross(e2);
   const double det = e1.dot(p);
@@ -210,7 +212,8 @@ RayHit hit_in_double(const Eigen::Vector3d& origin, const Eigen::Vector3d& direc
     u /= sum;
     v /= sum;
   }
-  return RayHit{t, found.face, Eigen::Vector2d(u, v)};
+  // ... and its distance a rounding outside the range Embree searched.
+  return RayHit{std::clamp(t, t_near, t_far), found.face, Eigen::Vector2d(u, v)};
 }
 
 ClosestPoint SurfaceQuery::closest_point(const Eigen::Vector3d& point) const {

@@ -30,10 +30,12 @@ struct RayHit {
 //! precision: its distance and barycentric coordinates (clamped into the triangle), the face
 //! kept. Embree's float answer depends on its instruction-set path and on the CPU's reciprocal
 //! approximation (which may differ between CPU makers), and the synthetic renders and the
-//! held-out renders shade it; this one is the same bits on every CPU. \p found itself when the ray is
-//! parallel to the triangle in double.
+//! held-out renders shade it; this one is the same bits on every CPU. The distance is clamped
+//! into [t_near, t_far], the range searched. \p found itself when the ray is parallel to the
+//! triangle in double (then the bits are Embree's again).
 RayHit hit_in_double(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, const Eigen::Vector3d& a,
-                     const Eigen::Vector3d& b, const Eigen::Vector3d& c, const RayHit& found);
+                     const Eigen::Vector3d& b, const Eigen::Vector3d& c, const RayHit& found, double t_near = 0.0,
+                     double t_far = std::numeric_limits<double>::infinity());
 
 //! The point of the surface nearest to a query point (exact, in double precision).
 struct ClosestPoint {

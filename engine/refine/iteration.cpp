@@ -42,6 +42,13 @@ class StageTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
+double largest_speed(const VertexFields& fields) {
+  double largest = 0.0;
+  for (std::size_t v = 0; v < fields.size(); ++v)
+    if (fields.defined[v] & kSpeedDefined) largest = std::max(largest, fields.speed[v].norm());
+  return largest;
+}
+
 // Every per-block kernel: nothing once the run is cancelled (the rest of a cancelled graph
 // drains at once), \p body timed into \p seconds (null: untimed), then on_block.
 template <class Body>
@@ -179,24 +186,11 @@ void IterationData::cfl() {
   }
   total.sum_g = sum_g;
   far_count = far_views != nullptr ? update_far_vertices(mesh, views, fields, options.far, far) : 0;
-  // Where the background shows through, the speed's sign is noise; the region moves by its mean.
-  implausible_count = 0;
-  if (options.unobserved_displacement.implausible_g_ratio > 0.0 && rim_masks == nullptr) {
-    const std::vector<std::uint8_t> implausible =
-        implausible_g_vertices(mesh, fields, options.unobserved_displacement.implausible_g_ratio);
-    for (const std::uint8_t flag : implausible) implausible_count += flag;
-    if (average_implausible_speeds(mesh, implausible, options.implausible_speed, fields) > 0) {
-      total.max_speed = 0.0;
-      for (std::size_t v = 0; v < fields.size(); ++v)
-        if (fields.defined[v] & kSpeedDefined) total.max_speed = std::max(total.max_speed, fields.speed[v].norm());
-    }
-  }
-  // Before the step: weakly seen vertices only follow it, so they leave the maximum too.
-  if (demote_weakly_seen(mesh, views, options.unobserved, fields) > 0) {
-    total.max_speed = 0.0;
-    for (std::size_t v = 0; v < fields.size(); ++v)
-      if (fields.defined[v] & kSpeedDefined) total.max_speed = std::max(total.max_speed, fields.speed[v].norm());
-  }
+  // Before the step: weakly seen vertices only follow it, so they leave the maximum too; then the
+  // speeds of implausibly high g are averaged among the vertices that keep a speed.
+  const bool demoted = demote_weakly_seen(mesh, views, options.unobserved, fields) > 0;
+  const bool averaged = average_implausible() > 0;
+  if (demoted || averaged) total.max_speed = largest_speed(fields);
   const double reference_speed =
       options.speed_quantile < 1.0 ? speed_quantile(mesh, fields, options.speed_quantile) : total.max_speed;
   const double step_edge = options.local_step ? mean_edge : shortest_edge;
@@ -208,6 +202,16 @@ void IterationData::cfl() {
   moving = 0;
   for (std::uint8_t bits : fields.defined) moving += (bits & kSpeedDefined) != 0;
   if (options.unobserved.fill) fill_speeds();
+}
+
+std::size_t IterationData::average_implausible() {
+  // Where the background shows through, the speed's sign is noise; the region moves by its mean.
+  implausible_count = 0;
+  if (!(options.unobserved_displacement.implausible_g_ratio > 0.0) || rim_masks != nullptr) return 0;
+  const std::vector<std::uint8_t> implausible =
+      implausible_g_vertices(mesh, fields, options.unobserved_displacement.implausible_g_ratio);
+  for (const std::uint8_t flag : implausible) implausible_count += flag;
+  return average_implausible_speeds(mesh, implausible, options.implausible_speed, fields);
 }
 
 void IterationData::fill_speeds() {

@@ -98,7 +98,7 @@ struct IterationData {
   std::size_t moving = 0;
   std::size_t far_count = 0;  //!< set by cfl(): the far vertices for the next iteration (0 without far_views)
   //! set by cfl(): the vertices of implausibly high g with their ring (implausible_g_vertices; 0
-  //! where the rule is off or the rims are fitted), whose speeds it averaged (ImplausibleSpeedOptions)
+  //! where the ratio is 0 or the rims are fitted), whose speeds it averaged (ImplausibleSpeedOptions)
   std::size_t implausible_count = 0;
   double serial_seconds[kStageCount] = {};
 
@@ -125,6 +125,9 @@ struct IterationData {
   void cfl();                          //!< serial: combine partials in block order, Δt, median move
   void adapt_step_scale();             //!< part of cfl(): the step control
   void fill_speeds();                  //!< part of cfl(): speeds of unobserved vertices
+  //! part of cfl(): averages the speeds of implausibly high g (ImplausibleSpeedOptions) where the
+  //! rule applies, sets implausible_count; returns the vertices averaged
+  std::size_t average_implausible();
   //! the steps damped (options.damping), the last steps carried (options.momentum), then P ← P + Δt·F
   void move(std::size_t block);
   void measure_moves();                //!< serial, after the iteration: median_move and net_move_over_edge

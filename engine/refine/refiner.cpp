@@ -212,8 +212,9 @@ class Refinement {
       control_.logger->info("{} follow the observed surface{}",
                             spreads_hardly_observed_ ? "hardly observed vertices" : "unobserved vertices",
                             data_.rim_masks ? " and the silhouette rims" : "");
-    if (control_.logger && spreads_ && data_.rim_masks && options_.unobserved_displacement.implausible_g_ratio > 0.0)
-      control_.logger->info("the rims are fitted: implausible g ratio {} not applied (the silhouettes hold the outline)",
+    if (control_.logger && data_.rim_masks && options_.unobserved_displacement.implausible_g_ratio > 0.0)
+      control_.logger->info("the rims are fitted: implausible g ratio {} not applied, neither to the spread nor to the "
+                            "speeds (the silhouettes hold the outline)",
                             options_.unobserved_displacement.implausible_g_ratio);
     data_.reset_topology();  // the first iteration's Embree scene serves the initial evaluation too
     summary.initial_sum_g_per_vertex = evaluate_surface(mesh_, flow_views(), full_views_, *data_.surface, options_).sum_g_per_vertex;

@@ -185,7 +185,7 @@ HeldoutRendering HeldoutRenderer::render(int view) const {
           ++hits;
           const auto& t = flat_.triangles[hit->face];
           const double b1 = hit->barycentric.x(), b2 = hit->barycentric.y();
-          // The point from the triangle in double (Embree's hit distance is float).
+          // The point from the triangle's own positions: on its plane, up to rounding.
           const Eigen::Vector3d point =
               (1 - b1 - b2) * flat_.positions[t[0]] + b1 * flat_.positions[t[1]] + b2 * flat_.positions[t[2]];
           // The side the held-out camera sees, whatever the face's orientation.

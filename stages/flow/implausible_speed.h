@@ -5,7 +5,9 @@
 // vertex (±7 against a median of 0.6 inward), the step damping held the region at a fraction of
 // its step, and it crept in over 100 and more iterations. Each such vertex's speed becomes the mean
 // over its neighbourhood instead: the noise averages out, the region's common motion (the
-// curvature term g·H, the pull of the surface around it) stays.
+// curvature term g·H, the pull of the surface around it) stays. The mean is of the speed vectors
+// F·N (on a curved region it gains a part along the surface, which the tangential regularization
+// evens out); a mean of F along each vertex's own normal was not measured.
 
 #include <cstddef>
 #include <cstdint>
