@@ -207,9 +207,8 @@ void IterationData::cfl() {
 std::size_t IterationData::average_implausible() {
   // Where the background shows through, the speed's sign is noise; the region moves by its mean.
   implausible_count = 0;
-  if (!(options.unobserved_displacement.implausible_g_ratio > 0.0) || rim_masks != nullptr) return 0;
-  const std::vector<std::uint8_t> implausible =
-      implausible_g_vertices(mesh, fields, options.unobserved_displacement.implausible_g_ratio);
+  if (!(applied_implausible_g_ratio() > 0.0)) return 0;
+  const std::vector<std::uint8_t> implausible = implausible_g_vertices(mesh, fields, applied_implausible_g_ratio());
   for (const std::uint8_t flag : implausible) implausible_count += flag;
   return average_implausible_speeds(mesh, implausible, options.implausible_speed, fields);
 }

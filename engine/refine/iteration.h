@@ -128,6 +128,11 @@ struct IterationData {
   //! part of cfl(): averages the speeds of implausibly high g (ImplausibleSpeedOptions) where the
   //! rule applies, sets implausible_count; returns the vertices averaged
   std::size_t average_implausible();
+  //! UnobservedDisplacementOptions::implausible_g_ratio as applied, to the speeds and to the
+  //! unobserved spread: 0 where the rims are fitted (the silhouettes hold the outline there).
+  double applied_implausible_g_ratio() const {
+    return rim_masks != nullptr ? 0.0 : options.unobserved_displacement.implausible_g_ratio;
+  }
   //! the steps damped (options.damping), the last steps carried (options.momentum), then P ← P + Δt·F
   void move(std::size_t block);
   void measure_moves();                //!< serial, after the iteration: median_move and net_move_over_edge

@@ -385,12 +385,10 @@ class Refinement {
     return first ? options_.unobserved_displacement.first_hardly_observed_fraction : spread_fraction();
   }
 
-  // The unobserved spread's options as applied. Implausibly high g marks the background showing
-  // through; where the rims are fitted the silhouettes hold the outline, so not there
-  // (UnobservedDisplacementOptions::implausible_g_ratio).
+  // The unobserved spread's options as applied (IterationData::applied_implausible_g_ratio).
   UnobservedDisplacementOptions observed_options() const {
     UnobservedDisplacementOptions options = options_.unobserved_displacement;
-    if (data_.rim_masks) options.implausible_g_ratio = 0.0;
+    options.implausible_g_ratio = data_.applied_implausible_g_ratio();
     return options;
   }
 

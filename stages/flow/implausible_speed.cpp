@@ -20,22 +20,23 @@ std::size_t average_implausible_speeds(const TriMesh& mesh, std::span<const std:
   for (std::uint32_t v = 0; v < implausible.size(); ++v)
     if (implausible[v] && (fields.defined[v] & kSpeedDefined)) flagged.push_back(v);
   if (options.rings == 0 || flagged.empty()) return 0;
-  // Each round reads the previous round's speeds only (Jacobi), so the order does not matter.
-  std::vector<Eigen::Vector3d> speed = fields.speed, next = fields.speed;
+  // Each round reads the previous round's speeds only (Jacobi: all means first, then all written),
+  // so the order does not matter; only the flagged vertices' new speeds need room.
+  std::vector<Eigen::Vector3d> mean(flagged.size());
   for (int round = 0; round < options.rings; ++round) {
-    for (const std::uint32_t v : flagged) {
-      Eigen::Vector3d sum = speed[v];
+    for (std::size_t k = 0; k < flagged.size(); ++k) {
+      const std::uint32_t v = flagged[k];
+      Eigen::Vector3d sum = fields.speed[v];
       int count = 1;
       for (auto w : mesh.vv_range(TriMesh::VertexHandle(static_cast<int>(v))))
         if (fields.defined[w.idx()] & kSpeedDefined) {
-          sum += speed[w.idx()];
+          sum += fields.speed[w.idx()];
           ++count;
         }
-      next[v] = sum / count;
+      mean[k] = sum / count;
     }
-    for (const std::uint32_t v : flagged) speed[v] = next[v];
+    for (std::size_t k = 0; k < flagged.size(); ++k) fields.speed[flagged[k]] = mean[k];
   }
-  for (const std::uint32_t v : flagged) fields.speed[v] = speed[v];
   return flagged.size();
 }
 
