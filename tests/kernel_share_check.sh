@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# perf/kernel_share.sh, one short round of the baseline build: the share it prints is the
+# kernel's reads per second over the bound's (recomputed here from the printed rates), the
+# summary line quotes it; an unknown build and bad counts are refused.
+#   tests/kernel_share_check.sh STAGES_BENCHMARK MVFLOW SOURCE_DIR WORK_DIR
+set -euo pipefail
+bench=$1 mvflow=$2 root=$3 work=$4
+rm -rf "$work"
+mkdir -p "$work"
+BENCH=$bench MVFLOW=$mvflow MVFLOW_KERNELS=baseline BENCH_MIN_TIME=0.01 bash "$root/perf/kernel_share.sh" 1 1 > "$work/out.txt"
+python3 - "$work/out.txt" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+row = re.search(r'round 1 baseline +kernel +([\d.]+) ms \(([\d.e+]+) reads/s\) +bound +([\d.]+) ms \(([\d.e+]+) reads/s\) +share +([\d.]+) %', text)
+assert row, text
+kernel_ms, kernel_reads, bound_ms, bound_reads, share = map(float, row.groups())
+assert kernel_ms > 0 and bound_ms > 0, text
+# The rates are printed to 3 significant digits, the share to 0.1 % from the unrounded rates.
+expected = 100 * kernel_reads / bound_reads
+assert abs(share - expected) <= 0.05 + expected * 0.002, (share, expected, text)
+summary = re.search(r'baseline: median share of its own bound ([\d.]+) % \(([\d.]+)-([\d.]+) % over 1 rounds\)', text)
+assert summary and summary.group(1) == summary.group(2) == summary.group(3), text
+assert abs(float(summary.group(1)) - share) <= 0.05, text
+PY
+if BENCH=$bench MVFLOW=$mvflow MVFLOW_KERNELS=bogus BENCH_MIN_TIME=0.01 bash "$root/perf/kernel_share.sh" 1 1 \
+    > /dev/null 2> "$work/err.txt"; then
+  echo "an unknown build was not refused" >&2; exit 1
+fi
+grep -q 'the bogus build failed: MVFLOW_KERNEL=bogus: unknown build' "$work/err.txt" || { cat "$work/err.txt" >&2; exit 1; }
+for counts in "0" "1 0" "x"; do
+  status=0
+  # shellcheck disable=SC2086
+  BENCH=$bench MVFLOW=$mvflow bash "$root/perf/kernel_share.sh" $counts > /dev/null 2>&1 || status=$?
+  [ "$status" -eq 2 ] || { echo "counts '$counts' gave exit $status, expected 2" >&2; exit 1; }
+done
+echo "kernel_share.sh: ok"
