@@ -44,9 +44,7 @@ for ((round = 1; round <= rounds; ++round)); do
     if ! MVFLOW_KERNEL=$kernel "$bench" --benchmark_filter='^(BM_PhotoGradient|BM_PatchGatherBound)$' \
         --benchmark_repetitions="$repetitions" --benchmark_report_aggregates_only=true \
         --benchmark_format=json "${min_time[@]}" > "$out" 2> "$work/err.txt"; then
-      # The benchmark throws at the first use of a build this CPU cannot run: its what() says why.
-      reason=$(sed -n 's/^ *what(): *//p' "$work/err.txt" | head -n 1)
-      echo "kernel_share.sh: the $kernel build failed: ${reason:-$(head -n 1 "$work/err.txt")}" >&2
+      echo "kernel_share.sh: the $kernel build failed: $(head -n 1 "$work/err.txt")" >&2
       exit 1
     fi
     python3 - "$out" "$round" "$kernel" >> "$work/rows.txt" <<'EOF'

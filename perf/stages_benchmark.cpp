@@ -10,10 +10,12 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "engine/refine/iteration.h"
 #include "engine/refine/iteration_graph.h"
+#include "engine/model/error.h"
 #include "engine/model/mesh_stats.h"
 #include "engine/model/surface_query.h"
 #include "perf/bench_scene.h"
@@ -401,4 +403,18 @@ BENCHMARK(BM_Iteration)
 }  // namespace
 }  // namespace mvflow
 
-BENCHMARK_MAIN();
+// BENCHMARK_MAIN with the photo kernel's build chosen first: MVFLOW_KERNEL naming a build this
+// CPU cannot run (or an unknown one) is said in one line and exits 1, before the scene is rendered.
+int main(int argc, char** argv) {
+  try {
+    (void)mvflow::detail::active_photo_kernel();
+  } catch (const mvflow::Error& error) {
+    std::fprintf(stderr, "mvflow_stages_benchmark: %s\n", error.what());
+    return 1;
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

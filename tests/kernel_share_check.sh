@@ -26,7 +26,8 @@ if BENCH=$bench MVFLOW=$mvflow MVFLOW_KERNELS=bogus BENCH_MIN_TIME=0.01 bash "$r
     > /dev/null 2> "$work/err.txt"; then
   echo "an unknown build was not refused" >&2; exit 1
 fi
-grep -q 'the bogus build failed: MVFLOW_KERNEL=bogus: unknown build' "$work/err.txt" || { cat "$work/err.txt" >&2; exit 1; }
+grep -q 'the bogus build failed: mvflow_stages_benchmark: MVFLOW_KERNEL=bogus: unknown build' "$work/err.txt" ||
+  { cat "$work/err.txt" >&2; exit 1; }
 for counts in "0" "1 0" "x"; do
   status=0
   # shellcheck disable=SC2086
