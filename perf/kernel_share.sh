@@ -47,9 +47,9 @@ for ((round = 1; round <= rounds; ++round)); do
       echo "kernel_share.sh: the $kernel build failed: $(head -n 1 "$work/err.txt")" >&2
       exit 1
     fi
-    python3 - "$out" "$round" "$kernel" >> "$work/rows.txt" <<'EOF'
+    python3 - "$out" "$round" "$kernel" "$work/rows.txt" <<'EOF'
 import json, sys
-path, round_, kernel = sys.argv[1:]
+path, round_, kernel, rows = sys.argv[1:]
 runs = json.load(open(path))['benchmarks']
 def median(name):
     for run in runs:
@@ -59,10 +59,12 @@ def median(name):
     sys.exit(f'kernel_share.sh: no median of {name} in {path}')
 kernel_ms, kernel_reads = median('BM_PhotoGradient')
 bound_ms, bound_reads = median('BM_PatchGatherBound')
-print(round_, kernel, f'{kernel_ms:.3f}', f'{kernel_reads:.6g}', f'{bound_ms:.3f}', f'{bound_reads:.6g}',
-      f'{100 * kernel_reads / bound_reads:.2f}')
+share = 100 * kernel_reads / bound_reads
+with open(rows, 'a') as out:  # for the summary over the rounds
+    print(kernel, share, file=out)
+print(f'round {round_} {kernel:<8} kernel {kernel_ms:8.2f} ms ({kernel_reads:.3g} reads/s)   '
+      f'bound {bound_ms:7.2f} ms ({bound_reads:.3g} reads/s)   share {share:5.1f} %')
 EOF
-    tail -n 1 "$work/rows.txt" | awk '{ printf "round %s %-8s kernel %8.2f ms (%.3g reads/s)   bound %7.2f ms (%.3g reads/s)   share %5.1f %%\n", $1, $2, $3, $4, $5, $6, $7 }'
   done
 done
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
@@ -70,7 +72,7 @@ python3 - "$work/rows.txt" $kernels <<'EOF'
 import statistics, sys
 rows = [line.split() for line in open(sys.argv[1])]
 for kernel in sys.argv[2:]:
-    shares = [float(r[6]) for r in rows if r[1] == kernel]
+    shares = [float(r[1]) for r in rows if r[0] == kernel]
     print(f'{kernel}: median share of its own bound {statistics.median(shares):.1f} % '
           f'({min(shares):.1f}-{max(shares):.1f} % over {len(shares)} rounds)')
 EOF
