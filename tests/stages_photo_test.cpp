@@ -198,8 +198,9 @@ TEST(PhotoConsistency, EveryInstructionSetBuildGivesTheSameBits) {
 }
 
 TEST(PhotoConsistency, EveryBuildGivesTheSameBitsBeyondItsStackBuffers) {
-  // More than 64 views and more than 32 samples per axis: the kernel's buffers move to the heap
-  // (a std::vector of AVX2 sums once came out 16-byte aligned there and faulted).
+  // More than 64 views and more than 32 samples per axis: the kernel's per-view buffers and its
+  // sums move to the heap (a std::vector of AVX2 sums once came out 16-byte aligned there and
+  // faulted); its tables of 32 + kLanes entries (offsets, totals) only for the 2-lane baseline.
   std::mt19937 random(8);
   const auto [cameras, images] = random_rig(70, 0.09, 0.4, random);
   const auto views = make_photo_views(cameras, pointers(images));
