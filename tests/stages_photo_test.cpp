@@ -200,7 +200,8 @@ TEST(PhotoConsistency, EveryInstructionSetBuildGivesTheSameBits) {
 TEST(PhotoConsistency, EveryBuildGivesTheSameBitsBeyondItsStackBuffers) {
   // More than 64 views and more than 32 samples per axis: the kernel's per-view buffers and its
   // sums move to the heap (a std::vector of AVX2 sums once came out 16-byte aligned there and
-  // faulted); its tables of 32 + kLanes entries (offsets, totals) only for the 2-lane baseline.
+  // faulted); its tables of 32 + kLanes entries (offsets, totals) stay on the stack (34 samples
+  // fill the baseline's exactly).
   std::mt19937 random(8);
   const auto [cameras, images] = random_rig(70, 0.09, 0.4, random);
   const auto views = make_photo_views(cameras, pointers(images));
