@@ -13,6 +13,7 @@
 # missing), PAIRS to 7; MVFLOW=build/tools/mvflow and MVFLOW_KERNEL pass through.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+TIMEFORMAT='%U %S'
 mvflow=${MVFLOW:-build/tools/mvflow}
 scene=${1:-/tmp/mvflow-openmvs-case}
 pairs=${2:-7}
@@ -30,10 +31,11 @@ echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 for ((pair = 1; pair <= pairs; ++pair)); do
   for threads in 1 2; do
     start=$(date +%s.%N)
-    "$mvflow" --log-level warn refine "$scene" -o "$work/out$threads.ply" --report "$work/report$threads.json" \
-      --threads "$threads" "${refine_options[@]}" >/dev/null
+    # bash's own `time` for the CPU seconds (user + system) of the run; its errors still reach stderr.
+    { time "$mvflow" --log-level warn refine "$scene" -o "$work/out$threads.ply" --report "$work/report$threads.json" \
+        --threads "$threads" "${refine_options[@]}" >/dev/null 2>&3; } 3>&2 2> "$work/cpu"
     end=$(date +%s.%N)
-    echo "$pair $threads $start $end" >> "$work/times"
+    echo "$pair $threads $start $end $(cat "$work/cpu")" >> "$work/times"
     cp "$work/report$threads.json" "$work/report_${pair}_$threads.json"
   done
   cmp -s "$work/out1.ply" "$work/out2.ply" || { echo "thread_ratio.sh: 1 and 2 threads gave different meshes" >&2; exit 1; }
@@ -43,10 +45,11 @@ echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
 python3 - "$work" "$pairs" <<'EOF'
 import json, statistics, sys
 work, pairs = sys.argv[1], int(sys.argv[2])
-wall = {}
+wall, cpu = {}, {}
 for line in open(work + '/times'):
-    pair, threads, start, end = line.split()
+    pair, threads, start, end, user, system = line.split()
     wall[(int(pair), int(threads))] = float(end) - float(start)
+    cpu[(int(pair), int(threads))] = float(user) + float(system)
 reports = {(p, t): json.load(open(f'{work}/report_{p}_{t}.json')) for p in range(1, pairs + 1) for t in (1, 2)}
 refine = {k: r['seconds'] for k, r in reports.items()}
 # The iterations' own seconds, and the rest of the refinement (preparing, decoding, the initial
@@ -69,4 +72,12 @@ print(f'median 1 -> 2 thread speedup: whole refine {statistics.median(whole):.2f
 # is the least disturbed one, so their ratio is a second estimate that drift moves less.
 fastest = {t: min(wall[(p, t)] for p in range(1, pairs + 1)) for t in (1, 2)}
 print(f'fastest runs: {fastest[1]:.2f} / {fastest[2]:.2f} s = {fastest[1] / fastest[2]:.2f}x')
+# Busy cores of the 2-thread run, CPU seconds over wall seconds, both taken within that one run:
+# drift between the runs of a pair does not move it (the ratios above swing by 0.2 where it moves
+# by 0.01). 2 − it is the share of the run with one core idle (the serial parts); it is an upper
+# bound on the speedup, for oneTBB's idle workers spin a little before they sleep (counted as busy)
+# and work a second thread adds (counted, not useful) raises it too.
+busy = [cpu[(p, 2)] / wall[(p, 2)] for p in range(1, pairs + 1)]
+print(f'2-thread runs: {statistics.median(busy):.3f} cores busy on average (CPU s / wall s, pairs '
+      f'{min(busy):.3f}-{max(busy):.3f}); 1-thread runs {statistics.median(cpu[(p, 1)] / wall[(p, 1)] for p in range(1, pairs + 1)):.3f}')
 EOF

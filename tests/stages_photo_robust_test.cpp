@@ -11,6 +11,8 @@
 #include <numbers>
 #include <random>
 
+#include <tbb/task_arena.h>
+
 #include "engine/model/primitives.h"
 #include "engine/model/surface_query.h"
 #include "stages/flow/image_pyramid.h"
@@ -371,6 +373,44 @@ TEST(ImagePyramid, TheHalfCameraSeesTheHalfImageWhereTheFullOneSeesTheFull) {
   ASSERT_EQ(level->views.size(), 1u);
   EXPECT_EQ(level->views[0].width, 80);
   EXPECT_EQ(level->images[0].pixel(7, 5), half.pixel(7, 5));
+}
+
+TEST(ImagePyramid, EveryViewIsHalvedInItsOwnSlotWhateverTheThreadCount) {
+  // Views of different sizes and contents, halved in parallel: each level image must be its own
+  // view's 2×2 means (written out here), in view order, the same bits with one thread or two.
+  std::vector<Camera> cameras;
+  std::vector<Image> images;
+  std::mt19937 random(11);
+  std::uniform_real_distribution<float> value(0.0f, 1.0f);
+  for (int i = 0; i < 7; ++i) {
+    const int width = 17 + 6 * i, height = 16 + 3 * i;
+    cameras.push_back(look_at({0.2 * i, 0.5, 4}, {0, 0, 0}, {0, 1, 0}, 40, width, height));
+    Image image(width, height);
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) image.set_pixel(x, y, {value(random), value(random), value(random)});
+    images.push_back(std::move(image));
+  }
+  std::vector<const Image*> pointers;
+  for (const Image& image : images) pointers.push_back(&image);
+  const auto views = make_photo_views(cameras, pointers);
+  std::unique_ptr<ImageLevel> one, two;
+  tbb::task_arena(1).execute([&] { one = half_resolution(views); });
+  tbb::task_arena(2).execute([&] { two = half_resolution(views); });
+  ASSERT_EQ(one->images.size(), images.size());
+  ASSERT_EQ(two->images.size(), images.size());
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    const Image& source = images[i];
+    ASSERT_EQ(two->images[i].width(), source.width() / 2) << "view " << i;
+    ASSERT_EQ(two->images[i].height(), source.height() / 2) << "view " << i;
+    EXPECT_EQ(two->views[i].width, source.width() / 2);
+    for (int y = 0; y < source.height() / 2; ++y)
+      for (int x = 0; x < source.width() / 2; ++x) {
+        const Eigen::Vector3f mean = 0.25f * ((source.pixel(2 * x, 2 * y) + source.pixel(2 * x + 1, 2 * y)) +
+                                              (source.pixel(2 * x, 2 * y + 1) + source.pixel(2 * x + 1, 2 * y + 1)));
+        ASSERT_EQ(two->images[i].pixel(x, y), mean) << "view " << i << " pixel " << x << ", " << y;
+        ASSERT_EQ(one->images[i].pixel(x, y), mean) << "view " << i << " pixel " << x << ", " << y;
+      }
+  }
 }
 
 }  // namespace
