@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The photo kernel against its own gather bound, per build (issue 13's "≥ 40 % of its own
-# bound"): `BM_PhotoGradient` (g with its gradient, 61 evaluations per vertex) and
-# `BM_PatchGatherBound` (the same 6×6-pixel blocks loaded and summed, nothing else, with that
-# build's loads) of build/perf/mvflow_stages_benchmark, each build forced with MVFLOW_KERNEL, the
-# builds alternated within each round (a shared machine's speed drifts within minutes). Prints per
-# round and build the medians of the repetitions and the share (the kernel's patch-pixel reads per
-# second over the bound's), then per build the median share over the rounds and its range.
+# bound"): `BM_PhotoGradientShareOfBound` of build/perf/mvflow_stages_benchmark runs g with its
+# gradient (61 evaluations per vertex, `BM_PhotoGradient`'s pass) and the bare reads of the same
+# 6×6-pixel blocks with that build's loads (`BM_PatchGatherBound`'s pass) alternated, pass by
+# pass, and gives the median over the pairs of bound time / kernel time: the share of the bound's
+# read rate. Since session 37: the two benchmarks run seconds apart read ±5 points apart on a
+# machine whose speed drifts within minutes; alternated pass by pass, ±0.6. Each build is forced
+# with MVFLOW_KERNEL, the builds alternated within each round. Prints per round and build the
+# medians of the repetitions, then per build the median share over the rounds and its range.
 #
 #   perf/kernel_share.sh [ROUNDS [REPETITIONS]]        (defaults 2 and 3)
 #
@@ -41,7 +43,7 @@ echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 for ((round = 1; round <= rounds; ++round)); do
   for kernel in $kernels; do
     out="$work/$round.$kernel.json"
-    if ! MVFLOW_KERNEL=$kernel "$bench" --benchmark_filter='^(BM_PhotoGradient|BM_PatchGatherBound)$' \
+    if ! MVFLOW_KERNEL=$kernel "$bench" --benchmark_filter='^BM_PhotoGradientShareOfBound$' \
         --benchmark_repetitions="$repetitions" --benchmark_report_aggregates_only=true \
         --benchmark_format=json "${min_time[@]}" > "$out" 2> "$work/err.txt"; then
       echo "kernel_share.sh: the $kernel build failed: $(head -n 1 "$work/err.txt")" >&2
@@ -51,19 +53,15 @@ for ((round = 1; round <= rounds; ++round)); do
 import json, sys
 path, round_, kernel, rows = sys.argv[1:]
 runs = json.load(open(path))['benchmarks']
-def median(name):
-    for run in runs:
-        if run['run_name'] == name and run.get('aggregate_name', 'median') == 'median':
-            scale = {'ns': 1e-6, 'us': 1e-3, 'ms': 1.0, 's': 1e3}[run['time_unit']]
-            return run['real_time'] * scale, run['patch_pixel_reads/s']
-    sys.exit(f'kernel_share.sh: no median of {name} in {path}')
-kernel_ms, kernel_reads = median('BM_PhotoGradient')
-bound_ms, bound_reads = median('BM_PatchGatherBound')
-share = 100 * kernel_reads / bound_reads
+# With one repetition Google Benchmark writes the run itself and no aggregates.
+median = next((run for run in runs if run.get('aggregate_name', 'median') == 'median'), None)
+if median is None:
+    sys.exit(f'kernel_share.sh: no median of BM_PhotoGradientShareOfBound in {path}')
+share = median['share_percent']
 with open(rows, 'a') as out:  # for the summary over the rounds
     print(kernel, share, file=out)
-print(f'round {round_} {kernel:<8} kernel {kernel_ms:8.2f} ms ({kernel_reads:.3g} reads/s)   '
-      f'bound {bound_ms:7.2f} ms ({bound_reads:.3g} reads/s)   share {share:5.1f} %')
+print(f'round {round_} {kernel:<8} kernel {median["kernel_ms"]:8.2f} ms   bound {median["bound_ms"]:7.2f} ms   '
+      f'share {share:5.1f} %   ({median["pairs"]:.0f} pairs per repetition)')
 EOF
   done
 done

@@ -8,10 +8,14 @@
 
 #include <oneapi/tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "engine/refine/iteration.h"
 #include "engine/refine/iteration_graph.h"
@@ -256,6 +260,45 @@ void BM_PatchGatherBound(benchmark::State& state) {
                  detail::active_photo_kernel().name + " build");
 }
 BENCHMARK(BM_PatchGatherBound)->Unit(benchmark::kMillisecond);
+
+// BM_PhotoGradient's share of BM_PatchGatherBound's read rate, the two passes alternated within
+// each benchmark iteration (kernel, then bound, each timed alone): a machine whose speed drifts by
+// tens of percent within minutes moves both passes of a pair alike, where the two benchmarks run
+// seconds apart each saw their own phase. Both read the same blocks, the same count, so the share
+// of a pair is bound time / kernel time; the counters give the median over the pairs (percent) and
+// the pairs' kernel and bound medians (ms). The benchmark's own time is that of both passes.
+void BM_PhotoGradientShareOfBound(benchmark::State& state) {
+  const StageScene& s = scene();
+  VertexFields fields = visible_fields();
+  PhotoGradientOptions options;
+  options.photo.surface_patch = SurfacePatchUse::Off;
+  const PhotoGradientStage stage(options);
+  const double spacing = sample_spacing();
+  const auto& blocks = gradient_blocks();
+  using Clock = std::chrono::steady_clock;
+  std::vector<double> kernel_ms, bound_ms, shares;
+  for (auto _ : state) {
+    const Clock::time_point start = Clock::now();
+    stage.run(s.mesh(), s.everything(), s.views, spacing, fields);
+    const Clock::time_point middle = Clock::now();
+    benchmark::DoNotOptimize(perf::gather_patch_blocks(blocks));
+    const Clock::time_point end = Clock::now();
+    kernel_ms.push_back(std::chrono::duration<double, std::milli>(middle - start).count());
+    bound_ms.push_back(std::chrono::duration<double, std::milli>(end - middle).count());
+    shares.push_back(100 * bound_ms.back() / kernel_ms.back());
+  }
+  const auto median = [](std::vector<double> values) {
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+  };
+  state.counters["share_percent"] = median(shares);
+  state.counters["kernel_ms"] = median(kernel_ms);
+  state.counters["bound_ms"] = median(bound_ms);
+  state.counters["pairs"] = static_cast<double>(shares.size());
+  state.SetLabel(std::string(detail::active_photo_kernel().name) + " build; g with its gradient against the bare reads, pairs alternated");
+}
+BENCHMARK(BM_PhotoGradientShareOfBound)->Unit(benchmark::kMillisecond);
 
 // What the refiner sets before an iteration runs: blocks and fields sized, the edge lengths and Δx.
 void prepare(IterationData& data, const StageScene& s) {
