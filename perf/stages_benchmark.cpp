@@ -157,14 +157,20 @@ void BM_PhotoConsistency(benchmark::State& state) {
 }
 BENCHMARK(BM_PhotoConsistency)->Unit(benchmark::kMillisecond);
 
+// The stage's options with 5×5 image patches at every vertex (--surface-patch off): the kernel
+// whose reads are counted against the gather bound.
+PhotoGradientOptions image_patches_only() {
+  PhotoGradientOptions options;
+  options.photo.surface_patch = SurfacePatchUse::Off;
+  return options;
+}
+
 // The 5×5 image-patch kernel alone (--surface-patch off), whose reads are counted against the
 // gather bound.
 void BM_PhotoGradient(benchmark::State& state) {
   const StageScene& s = scene();
   VertexFields fields = visible_fields();
-  PhotoGradientOptions options;
-  options.photo.surface_patch = SurfacePatchUse::Off;
-  const PhotoGradientStage stage(options);
+  const PhotoGradientStage stage(image_patches_only());
   const double evaluations = 3.0 * stage.options().savitzky_golay.k + 1;
   const double view_samples = static_cast<double>(gradient_blocks().size());
   const double spacing = sample_spacing();
@@ -270,9 +276,7 @@ BENCHMARK(BM_PatchGatherBound)->Unit(benchmark::kMillisecond);
 void BM_PhotoGradientShareOfBound(benchmark::State& state) {
   const StageScene& s = scene();
   VertexFields fields = visible_fields();
-  PhotoGradientOptions options;
-  options.photo.surface_patch = SurfacePatchUse::Off;
-  const PhotoGradientStage stage(options);
+  const PhotoGradientStage stage(image_patches_only());
   const double spacing = sample_spacing();
   const auto& blocks = gradient_blocks();
   using Clock = std::chrono::steady_clock;
