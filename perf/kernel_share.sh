@@ -54,7 +54,10 @@ import json, sys
 path, round_, kernel, rows = sys.argv[1:]
 runs = json.load(open(path))['benchmarks']
 # With one repetition Google Benchmark writes the run itself and no aggregates.
-median = next((run for run in runs if run.get('aggregate_name', 'median') == 'median'), None)
+if len(runs) == 1:
+    median = runs[0]
+else:
+    median = next((run for run in runs if run.get('run_type') == 'aggregate' and run.get('aggregate_name') == 'median'), None)
 if median is None:
     sys.exit(f'kernel_share.sh: no median of BM_PhotoGradientShareOfBound in {path}')
 share = median['share_percent']

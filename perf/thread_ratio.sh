@@ -14,6 +14,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 TIMEFORMAT='%U %S'
+export LC_ALL=C  # bash's `time` prints the locale's decimal mark; the summary parses a point
 mvflow=${MVFLOW:-build/tools/mvflow}
 scene=${1:-/tmp/mvflow-openmvs-case}
 pairs=${2:-7}
@@ -73,10 +74,11 @@ print(f'median 1 -> 2 thread speedup: whole refine {statistics.median(whole):.2f
 fastest = {t: min(wall[(p, t)] for p in range(1, pairs + 1)) for t in (1, 2)}
 print(f'fastest runs: {fastest[1]:.2f} / {fastest[2]:.2f} s = {fastest[1] / fastest[2]:.2f}x')
 # Busy cores of the 2-thread run, CPU seconds over wall seconds, both taken within that one run:
-# drift between the runs of a pair does not move it (the ratios above swing by 0.2 where it moves
-# by 0.01). 2 − it is the share of the run with one core idle (the serial parts); it is an upper
-# bound on the speedup, for oneTBB's idle workers spin a little before they sleep (counted as busy)
-# and work a second thread adds (counted, not useful) raises it too.
+# drift between the runs of a pair does not move it (the ratios above spread over 0.2 where it
+# spreads over 0.02). 2 − it is the share of the run with one core idle (the serial parts). On a
+# steady machine it bounds the speedup from above, for oneTBB's idle workers spin a little before
+# they sleep (counted as busy) and work a second thread adds (counted, not useful) raises it too;
+# a pair whose 1-thread run was slowed can read above it.
 busy = [cpu[(p, 2)] / wall[(p, 2)] for p in range(1, pairs + 1)]
 print(f'2-thread runs: {statistics.median(busy):.3f} cores busy on average (CPU s / wall s, pairs '
       f'{min(busy):.3f}-{max(busy):.3f}); 1-thread runs {statistics.median(cpu[(p, 1)] / wall[(p, 1)] for p in range(1, pairs + 1)):.3f}')

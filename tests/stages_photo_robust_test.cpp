@@ -400,8 +400,10 @@ TEST(ImagePyramid, EveryViewIsHalvedInItsOwnSlotWhateverTheThreadCount) {
   ASSERT_EQ(two->images.size(), images.size());
   for (std::size_t i = 0; i < images.size(); ++i) {
     const Image& source = images[i];
-    ASSERT_EQ(two->images[i].width(), source.width() / 2) << "view " << i;
-    ASSERT_EQ(two->images[i].height(), source.height() / 2) << "view " << i;
+    for (const ImageLevel* level : {one.get(), two.get()}) {
+      ASSERT_EQ(level->images[i].width(), source.width() / 2) << "view " << i;
+      ASSERT_EQ(level->images[i].height(), source.height() / 2) << "view " << i;
+    }
     EXPECT_EQ(two->views[i].width, source.width() / 2);
     for (int y = 0; y < source.height() / 2; ++y)
       for (int x = 0; x < source.width() / 2; ++x) {

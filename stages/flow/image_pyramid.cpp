@@ -42,7 +42,8 @@ std::unique_ptr<ImageLevel> half_resolution(const std::vector<PhotoView>& views)
     level->cameras.push_back(half_camera(*view.camera));
   }
   // The views in parallel: one after another this was a serial stretch of a whole refine (24
-  // views of 640×480: ~35 ms, 2 % of the peer-sized sphere case at 2 threads; perf/README).
+  // views of 640×480: ~50 ms with its page faults, 3 % of the peer-sized sphere case at 2 threads;
+  // perf/README "Session 37").
   level->images.resize(views.size());
   parallel::parallel_for(std::size_t{0}, views.size(),
                          [&](std::size_t i) { level->images[i] = half_image(*views[i].image); });
