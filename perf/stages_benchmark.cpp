@@ -299,15 +299,9 @@ void BM_PhotoGradientShareOfBound(benchmark::State& state) {
     }
     shares.push_back(100 * bound_ms.back() / kernel_ms.back());
   }
-  const auto median = [](std::vector<double> values) {
-    const auto upper = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), upper, values.end());
-    if (values.size() % 2 == 1) return *upper;
-    return 0.5 * (*std::max_element(values.begin(), upper) + *upper);  // the two middle values' mean
-  };
-  state.counters["share_percent"] = median(shares);
-  state.counters["kernel_ms"] = median(kernel_ms);
-  state.counters["bound_ms"] = median(bound_ms);
+  state.counters["share_percent"] = median_of(shares);
+  state.counters["kernel_ms"] = median_of(kernel_ms);
+  state.counters["bound_ms"] = median_of(bound_ms);
   state.counters["pairs"] = static_cast<double>(shares.size());
   state.SetLabel(std::string(detail::active_photo_kernel().name) + " build; g with its gradient against the bare reads, pairs alternated");
 }
