@@ -121,8 +121,8 @@ TEST(CliUnobserved, OnABlackBackgroundTheDefaultSpreadsAnchoredAtTheRims) {
 }
 
 // On a textured background auto spreads only the vertices that hardly had a speed at their
-// resolution; `on` every vertex without one. After the finest resolution only those it never gave
-// a speed follow (--spread-unmoved; auto there without fitted rims).
+// resolution; `on` every vertex without one. After the finest resolution, with --spread-unmoved
+// auto (off by default since session 38), only those it never gave a speed follow.
 TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved) {
   const test::ScratchFolder folder;
   const fs::path scene = folder / "scene";
@@ -157,16 +157,17 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
   // The cap (below −75°) ends nearer the sphere than without a spread.
   EXPECT_LT(cap_errors(folder / "auto.ply").cap, cap_errors(folder / "off.ply").cap);
 
-  // The spread at the end: one more spread than without it, after the last iteration, and it
-  // moves only vertices of the weakly seen parts (the run is the same until then, so the vertex
-  // ids match). Measured: 388 vertices moved, none within ±45°, before the step momentum; with
-  // it a dozen at 27–45° south (the crumpled band of the comment above), none between the rings'
-  // ±20°, and the run ends better (mean 0.0040 → 0.0030, completeness 99.3 → 100 %). Whether the
-  // spread brings a cap nearer depends on the scene: on the fifteen of the README 0.988× the
-  // error, here this rig's cap below −75° 0.0091 → 0.0105 (README, "Weakly seen regions").
-  const auto unmoved_off = test::run_mvflow(refine + " -o " +
-                                            (folder / "unmoved_off.ply").string() + " --spread-unmoved off");
-  ASSERT_EQ(unmoved_off.exit_code, 0) << unmoved_off.output;
+  // The spread at the end (--spread-unmoved auto): one more spread than without it (the
+  // default), after the last iteration, and it moves only vertices of the weakly seen parts (the
+  // run is the same until then, so the vertex ids match). Measured: 388 vertices moved, none
+  // within ±45°, before the step momentum; with it a dozen at 27–45° south (the crumpled band of
+  // the comment above), none between the rings' ±20°. Whether the spread brings a cap nearer
+  // depends on the scene: here this rig's cap below −75° 0.0091 → 0.0105; over the 32 scenes of
+  // the README it costs more than it gives since session 38 (README, "Weakly seen regions").
+  const auto unmoved_auto = test::run_mvflow(refine + " -o " + (folder / "unmoved_auto.ply").string() +
+                                             " --spread-unmoved auto");
+  ASSERT_EQ(unmoved_auto.exit_code, 0) << unmoved_auto.output;
+  const auto& unmoved_off = automatic;  // the default
   const auto spreads = [](const std::string& output) {
     std::size_t count = 0;
     for (std::size_t at = output.find("unobserved vertices with the observed surface"); at != std::string::npos;
@@ -174,12 +175,15 @@ TEST(CliUnobserved, OnATexturedBackgroundTheDefaultSpreadsOnlyTheHardlyObserved)
       ++count;
     return count;
   };
-  EXPECT_EQ(spreads(automatic.output), spreads(unmoved_off.output) + 1) << automatic.output;
-  EXPECT_GT(automatic.output.rfind("unobserved vertices with the observed surface"),
-            automatic.output.rfind("] iteration "))
-      << automatic.output;
-  const IndexedMesh at_end = io::read_mesh(folder / "auto.ply");
-  const IndexedMesh not_at_end = io::read_mesh(folder / "unmoved_off.ply");
+  EXPECT_EQ(spreads(unmoved_auto.output), spreads(unmoved_off.output) + 1) << unmoved_auto.output;
+  EXPECT_GT(unmoved_auto.output.rfind("unobserved vertices with the observed surface"),
+            unmoved_auto.output.rfind("] iteration "))
+      << unmoved_auto.output;
+  EXPECT_LT(unmoved_off.output.rfind("unobserved vertices with the observed surface"),
+            unmoved_off.output.rfind("] iteration "))
+      << unmoved_off.output;
+  const IndexedMesh at_end = io::read_mesh(folder / "unmoved_auto.ply");
+  const IndexedMesh not_at_end = io::read_mesh(folder / "auto.ply");
   ASSERT_EQ(at_end.positions.size(), not_at_end.positions.size());
   std::size_t moved_at_end = 0, in_caps = 0;
   for (std::size_t v = 0; v < at_end.positions.size(); ++v) {
