@@ -31,6 +31,8 @@ nlohmann::json iteration_json(const IterationReport& r) {
           {"net_normal_move_over_edge", std::isfinite(r.net_move) ? nlohmann::json(r.net_move) : nlohmann::json(nullptr)},
           {"net_normal_move_p90_over_edge",
            std::isfinite(r.net_move_tail) ? nlohmann::json(r.net_move_tail) : nlohmann::json(nullptr)},
+          {"net_normal_move_persistence",
+           std::isfinite(r.net_move_persistence) ? nlohmann::json(r.net_move_persistence) : nlohmann::json(nullptr)},
           {"stop", r.stop},
           {"seconds", r.seconds},
           {"stage_seconds", stages}};

@@ -176,6 +176,8 @@ void expect_same_bits(const RefineOptions& options) {
                 std::bit_cast<std::uint64_t>(reference.summary.iterations[i].net_move));
       EXPECT_EQ(std::bit_cast<std::uint64_t>(other->summary.iterations[i].net_move_tail),
                 std::bit_cast<std::uint64_t>(reference.summary.iterations[i].net_move_tail));
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(other->summary.iterations[i].net_move_persistence),
+                std::bit_cast<std::uint64_t>(reference.summary.iterations[i].net_move_persistence));
     }
   }
 }

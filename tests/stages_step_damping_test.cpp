@@ -261,5 +261,50 @@ TEST(NetNormalMove, IsTheRadialGrowthOverTheWindowInShortestEdges) {
   EXPECT_THROW(NetNormalMove(0), Error);
 }
 
+TEST(NetNormalMove, PersistenceIsTheShareOfTheLastWindowsMoveThatCarriesOn) {
+  const TriMesh base = icosphere(1.0, 3);
+  const VertexFields fields = sphere_fields(base);
+  const auto at_radius = [&](double radius) {
+    TriMesh mesh = base;
+    scale_sphere(mesh, radius);
+    return mesh;
+  };
+  // A creep slowing geometrically, r_i = 1 + 0.01·(1 − q^i): over one window of 5 every vertex
+  // moves q^5 times its move over the window before, so Σ a·b / Σ b² = q^5 whatever the edges.
+  constexpr double q = 0.9;
+  NetNormalMove net(5);
+  for (int i = 0; i <= 12; ++i) {
+    net.record(at_radius(1.0 + 0.01 * (1.0 - std::pow(q, i))), fields);
+    if (i < 10) {
+      EXPECT_TRUE(std::isnan(net.last_persistence())) << i;  // fewer than 2·5 + 1 positions
+    } else {
+      EXPECT_NEAR(net.last_persistence(), std::pow(q, 5), 1e-9) << i;
+    }
+  }
+  // A steady creep carries all of it on.
+  NetNormalMove steady(5);
+  for (int i = 0; i <= 10; ++i) steady.record(at_radius(1.0 + 0.001 * i), fields);
+  EXPECT_NEAR(steady.last_persistence(), 1.0, 1e-9);
+  // Back and forth by ±0.001 in turn: over an odd window each vertex ends on the other side of
+  // where the window before ended, by as much: −1.
+  NetNormalMove jitter(5);
+  for (int i = 0; i <= 11; ++i) {
+    jitter.record(at_radius(1.0 + (i % 2 ? -0.001 : 0.001)), fields);
+    if (i >= 10) {
+      EXPECT_NEAR(jitter.last_persistence(), -1.0, 1e-9) << i;
+    }
+  }
+  // Nothing moved in the earlier window: no share to speak of (NaN), and reset() forgets.
+  NetNormalMove still(1);
+  still.record(base, fields);
+  still.record(base, fields);
+  still.record(at_radius(1.001), fields);
+  EXPECT_TRUE(std::isnan(still.last_persistence()));
+  still.record(at_radius(1.002), fields);
+  EXPECT_NEAR(still.last_persistence(), 1.0, 1e-9);
+  still.reset();
+  EXPECT_TRUE(std::isnan(still.last_persistence()));
+}
+
 }  // namespace
 }  // namespace mvflow

@@ -201,5 +201,26 @@ TEST(Stopping, ReportsTheLastChanges) {
   EXPECT_NEAR(changes[1], 1.0, 1e-12);
 }
 
+TEST(Stopping, TheFinestResolutionHoldsAConvergedStopWhileTheMovePersists) {
+  const StoppingOptions on;
+  EXPECT_EQ(on.persistence_wait, 1.0);  // the default; the thesis preset's 0 never waits
+  // A level whose first stop came after 20 iterations waits up to iteration 39 of the level.
+  EXPECT_TRUE(holds_at_finest(on, StopReason::Converged, 0.14, 20, 20));
+  EXPECT_TRUE(holds_at_finest(on, StopReason::Converged, 0.14, 39, 20));
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Converged, 0.14, 40, 20));  // its patience is spent
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Converged, 0.0, 25, 20));   // moves that do not carry on
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Converged, -0.3, 25, 20));  // back and forth
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Converged, NAN, 25, 20));   // not yet two windows
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Settled, 0.5, 25, 20));     // the net move is small already
+  EXPECT_FALSE(holds_at_finest(on, StopReason::MaxIterations, 0.5, 25, 20));
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Continue, 0.5, 25, 20));
+  const StoppingOptions half{.persistence_wait = 0.5};
+  EXPECT_TRUE(holds_at_finest(half, StopReason::Converged, 0.5, 29, 20));
+  EXPECT_FALSE(holds_at_finest(half, StopReason::Converged, 0.5, 30, 20));
+  EXPECT_FALSE(holds_at_finest(StoppingOptions{.persistence_wait = 0.0}, StopReason::Converged, 0.5, 20, 20));
+  EXPECT_THROW((StoppingOptions{.persistence_wait = -1.0}).check(), OptionError);
+  EXPECT_THROW((StoppingOptions{.persistence_wait = INFINITY}).check(), OptionError);
+}
+
 }  // namespace
 }  // namespace mvflow

@@ -289,6 +289,11 @@ std::vector<RefineOptionEntry> make_table() {
                     "√(σ / this), σ after --denoise (0 = off; clean renders and photographs here read 0.0006–0.0018, README "
                     "\"Convergence\")",
                     [](auto& o) -> auto& { return o.stopping.settled_noise_reference; }));
+  t.push_back(value("--persistence-wait", "persistence_wait", "stopping.persistence_wait",
+                    "At the finest resolution the Σg stop waits while the surface's net move along the normal "
+                    "carries on from one window of iterations to the next, for at most this many times the "
+                    "iterations the level ran to its first stop (0 = no wait, the thesis preset; README \"Convergence\")",
+                    [](auto& o) -> auto& { return o.stopping.persistence_wait; }));
   t.push_back(switch_flag("--no-remeshing", "global_remeshing", "Skip the global split/collapse before the flow",
                           [](auto& o) -> auto& { return o.global_remeshing; }, false));
   t.push_back(value("--refine-min-pixels", "adaptive_min_edge_pixels", "adaptive.min_edge_pixels",

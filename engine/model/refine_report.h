@@ -55,6 +55,10 @@ struct IterationReport {
   //! the 90th percentile of the same (NetNormalMove::last_tail): the vertices still on their way
   //! when the median has settled; NaN where net_move is
   double net_move_tail = 0.0;
+  //! how much of the previous window's net move the last one carried on
+  //! (NetNormalMove::last_persistence, the finest resolution's hold); NaN in the first 2·lookback
+  //! iterations of a topology
+  double net_move_persistence = 0.0;
   std::string stop;                   //!< "continue", or why the refinement stops after it
   double seconds = 0.0;               //!< wall time of the whole iteration
   std::array<double, kStageCount> stage_seconds{};

@@ -48,6 +48,7 @@ RefineOptions thesis_preset() {
   options.stopping.median_move_tolerance = 0.002;
   options.stopping.settled_tolerance = 0.0;
   options.stopping.settled_noise_reference = 0.0;
+  options.stopping.persistence_wait = 0.0;
   options.damping.enabled = false;
   options.momentum.carry = 0.0;
   options.speed_quantile = 1.0;

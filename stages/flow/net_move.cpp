@@ -12,13 +12,14 @@ namespace mvflow {
 
 NetNormalMove::NetNormalMove(int window) : window_(window) {
   MVFLOW_CHECK(window >= 1, "NetNormalMove: the window must be >= 1");
-  ring_.resize(static_cast<std::size_t>(window) + 1);
+  ring_.resize(2 * static_cast<std::size_t>(window) + 1);
 }
 
 void NetNormalMove::reset() {
   next_ = 0;
   recorded_ = 0;
   last_tail_ = std::numeric_limits<double>::quiet_NaN();
+  last_persistence_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 double NetNormalMove::record(const TriMesh& mesh, const VertexFields& fields) {
@@ -32,18 +33,31 @@ double NetNormalMove::record(const TriMesh& mesh, const VertexFields& fields) {
   next_ = (next_ + 1) % ring_.size();
   ++recorded_;
   last_tail_ = std::numeric_limits<double>::quiet_NaN();
-  if (recorded_ < ring_.size()) return std::numeric_limits<double>::quiet_NaN();
+  last_persistence_ = std::numeric_limits<double>::quiet_NaN();
+  const auto window = static_cast<std::size_t>(window_);
+  if (recorded_ < window + 1) return std::numeric_limits<double>::quiet_NaN();
 
-  const std::vector<Eigen::Vector3d>& before = ring_[next_];  // the oldest: window iterations ago
+  const std::size_t slots = ring_.size();
+  const std::vector<Eigen::Vector3d>& before = ring_[(next_ + slots - 1 - window) % slots];  // window iterations ago
+  const bool two_windows = recorded_ >= slots;
+  const std::vector<Eigen::Vector3d>& older = ring_[next_];  // 2·window ago, when two_windows
   std::vector<double> relative;
   relative.reserve(n);
+  double product = 0.0, earlier_square = 0.0;  // Σ a·b, Σ b² (last_persistence)
   for (std::uint32_t v = 0; v < n; ++v) {
     if (!(fields.defined[v] & kSpeedDefined) || mesh.is_boundary(TriMesh::VertexHandle(static_cast<int>(v)))) continue;
     const double edge = fields.local_edge[v];
     if (!(edge > 0.0) || !std::isfinite(edge)) continue;
-    relative.push_back(std::abs((now[v] - before[v]).dot(fields.normal[v])) / edge);
+    const double last = (now[v] - before[v]).dot(fields.normal[v]) / edge;
+    relative.push_back(std::abs(last));
+    if (two_windows) {
+      const double earlier = (before[v] - older[v]).dot(fields.normal[v]) / edge;
+      product += last * earlier;
+      earlier_square += earlier * earlier;
+    }
   }
   if (relative.empty()) return std::numeric_limits<double>::quiet_NaN();
+  if (earlier_square > 0.0) last_persistence_ = product / earlier_square;
   const auto tail = relative.begin() +
                     static_cast<std::ptrdiff_t>(std::ceil(0.9 * static_cast<double>(relative.size()))) - 1;
   std::nth_element(relative.begin(), tail, relative.end());

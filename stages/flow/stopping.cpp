@@ -36,6 +36,8 @@ void StoppingOptions::check() const {
                  median_move_tolerance, ">= 0 and finite");
   require_option(settled_tolerance >= 0.0 && std::isfinite(settled_tolerance), "settled_tolerance", settled_tolerance,
                  ">= 0 and finite");
+  require_option(persistence_wait >= 0.0 && std::isfinite(persistence_wait), "persistence_wait", persistence_wait,
+                 ">= 0 and finite");
   require_option(settled_noise_reference >= 0.0 && std::isfinite(settled_noise_reference), "settled_noise_reference",
                  settled_noise_reference, ">= 0 and finite");
 }
@@ -44,6 +46,12 @@ double settled_tolerance_for_noise(const StoppingOptions& options, double image_
   if (!(options.settled_noise_reference > 0.0) || !(image_noise > options.settled_noise_reference))
     return options.settled_tolerance;
   return options.settled_tolerance * std::sqrt(image_noise / options.settled_noise_reference);
+}
+
+bool holds_at_finest(const StoppingOptions& options, StopReason reason, double persistence,
+                     std::size_t level_iterations, std::size_t first_stop) {
+  return reason == StopReason::Converged && persistence > 0.0 &&  // false for NaN
+         static_cast<double>(level_iterations) < (1.0 + options.persistence_wait) * static_cast<double>(first_stop);
 }
 
 StoppingCriterion::StoppingCriterion(StoppingOptions options) : options_(options) {
