@@ -304,6 +304,12 @@ TEST(NetNormalMove, PersistenceIsTheShareOfTheLastWindowsMoveThatCarriesOn) {
   EXPECT_NEAR(still.last_persistence(), 1.0, 1e-9);
   still.reset();
   EXPECT_TRUE(std::isnan(still.last_persistence()));
+  // After a reset two windows are needed again, though the ring still holds older positions.
+  still.record(at_radius(1.003), fields);
+  still.record(at_radius(1.004), fields);
+  EXPECT_TRUE(std::isnan(still.last_persistence()));
+  still.record(at_radius(1.005), fields);
+  EXPECT_NEAR(still.last_persistence(), 1.0, 1e-9);
 }
 
 }  // namespace

@@ -222,5 +222,30 @@ TEST(Stopping, TheFinestResolutionHoldsAConvergedStopWhileTheMovePersists) {
   EXPECT_THROW((StoppingOptions{.persistence_wait = INFINITY}).check(), OptionError);
 }
 
+TEST(Stopping, TheFinestResolutionWaitCountsFromItsFirstStop) {
+  const StoppingOptions options;  // persistence_wait 1
+  FinestResolutionWait wait;
+  EXPECT_FALSE(wait.reached());
+  // The first stop with nothing to refine, after 20 iterations of the level: reached, and it waits.
+  EXPECT_TRUE(wait.wait(options, StopReason::Converged, 0.2, 20, true));
+  EXPECT_TRUE(wait.reached());
+  EXPECT_EQ(wait.first_stop(), 20u);
+  // Later stops keep the first stop's 20: the wait ends at iteration 40 of the level, not 60.
+  EXPECT_TRUE(wait.wait(options, StopReason::Converged, 0.2, 30, true));
+  EXPECT_EQ(wait.first_stop(), 20u);
+  EXPECT_TRUE(wait.wait(options, StopReason::Converged, 0.2, 39, true));
+  EXPECT_FALSE(wait.wait(options, StopReason::Converged, 0.2, 40, true));
+  // No budget left: no wait, whatever the persistence.
+  EXPECT_FALSE(wait.wait(options, StopReason::Converged, 0.2, 25, false));
+  // A first stop that does not wait (settled, or no budget) still marks the finest resolution.
+  FinestResolutionWait settled;
+  EXPECT_FALSE(settled.wait(options, StopReason::Settled, 0.2, 12, true));
+  EXPECT_TRUE(settled.reached());
+  EXPECT_EQ(settled.first_stop(), 12u);
+  FinestResolutionWait none;
+  EXPECT_FALSE(none.wait(StoppingOptions{.persistence_wait = 0.0}, StopReason::Converged, 0.9, 15, true));
+  EXPECT_TRUE(none.reached());
+}
+
 }  // namespace
 }  // namespace mvflow

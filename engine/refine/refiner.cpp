@@ -269,17 +269,14 @@ class Refinement {
                                                    data_.net_move_over_edge);
       report.stop = to_string(reason);
       const bool budget_left = stopping.iterations() < static_cast<std::size_t>(options_.stopping.max_iterations);
-      if (budget_left && !finest_resolution_ && refine_at_convergence(reason, report)) {
+      if (budget_left && !finest_wait_.reached() && refine_at_convergence(reason, report)) {
         stopping.restart();
         reason = StopReason::Continue;
-      } else if (reason != StopReason::Continue && reason != StopReason::MaxIterations) {
-        if (!finest_resolution_) finest_first_stop_ = stopping.level_iterations();
-        finest_resolution_ = true;  // nothing left to refine: later stops end the run or wait
-        if (budget_left && holds_at_finest(options_.stopping, reason, data_.net_move.last_persistence(),
-                                           stopping.level_iterations(), finest_first_stop_)) {
-          report.stop = std::string("held (") + to_string(reason) + ")";
-          reason = StopReason::Continue;
-        }
+      } else if (reason != StopReason::Continue && reason != StopReason::MaxIterations &&
+                 finest_wait_.wait(options_.stopping, reason, data_.net_move.last_persistence(),
+                                   stopping.level_iterations(), budget_left)) {
+        report.stop = std::string("held (") + to_string(reason) + ")";
+        reason = StopReason::Continue;
       }
       summary.iterations.push_back(report);
       announce(report);
@@ -600,10 +597,8 @@ class Refinement {
   double denoise_sigma_ = 0.0;  //!< the blur of denoised_ in pixels (0: none)
   double flow_noise_ = 0.0;     //!< the noise the image patches' photographs keep (after the blur)
   int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
-  //! A stop found nothing left to refine (refine_at_convergence declined): the flow is at its
-  //! finest resolution, where a stop may wait (holds_at_finest) and is never retried as a refinement.
-  bool finest_resolution_ = false;
-  std::size_t finest_first_stop_ = 0;  //!< the finest resolution's iterations at its first stop
+  //! Whether a stop found nothing left to refine, and the wait there (StoppingOptions::persistence_wait).
+  FinestResolutionWait finest_wait_;
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the hardly observed (the spread is auto without rims: spread_fraction()).
   bool spreads_hardly_observed_ = false;

@@ -54,6 +54,13 @@ bool holds_at_finest(const StoppingOptions& options, StopReason reason, double p
          static_cast<double>(level_iterations) < (1.0 + options.persistence_wait) * static_cast<double>(first_stop);
 }
 
+bool FinestResolutionWait::wait(const StoppingOptions& options, StopReason reason, double persistence,
+                                std::size_t level_iterations, bool budget_left) {
+  if (!reached_) first_stop_ = level_iterations;
+  reached_ = true;
+  return budget_left && holds_at_finest(options, reason, persistence, level_iterations, first_stop_);
+}
+
 StoppingCriterion::StoppingCriterion(StoppingOptions options) : options_(options) {
   options_.check();
   history_.reserve(static_cast<std::size_t>(options_.max_iterations));

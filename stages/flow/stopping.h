@@ -96,6 +96,28 @@ double settled_tolerance_for_noise(const StoppingOptions& options, double image_
 bool holds_at_finest(const StoppingOptions& options, StopReason reason, double persistence,
                      std::size_t level_iterations, std::size_t first_stop);
 
+//! The finest resolution's wait (StoppingOptions::persistence_wait) over one run: the refiner
+//! asks it at every stop once a stop has found nothing left to refine.
+class FinestResolutionWait {
+ public:
+  //! A stop has found nothing left to refine: the flow is at its finest resolution, where a stop
+  //! is never tried as a refinement again.
+  bool reached() const { return reached_; }
+  //! The level's iterations at its first stop there (0 before).
+  std::size_t first_stop() const { return first_stop_; }
+
+  //! Called with a stop (\p reason neither Continue nor MaxIterations) that found nothing to
+  //! refine, after \p level_iterations iterations of the level: the first call marks the finest
+  //! resolution reached and records them as its first stop. Returns whether the stop waits:
+  //! \p budget_left and holds_at_finest with that first stop.
+  bool wait(const StoppingOptions& options, StopReason reason, double persistence, std::size_t level_iterations,
+            bool budget_left);
+
+ private:
+  bool reached_ = false;
+  std::size_t first_stop_ = 0;
+};
+
 //! The stopping test of the flow, fed once per completed iteration.
 //!
 //! Iterations are counted from 1: the i-th call of add_iteration reports iteration i, and
