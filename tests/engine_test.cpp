@@ -407,6 +407,72 @@ TEST(Refiner, ARefinementBelowTheMinimumGrowthEndsTheRun) {
   EXPECT_EQ(accepted.summary.iterations[first].declined_vertices, 0u);
 }
 
+// StoppingOptions::run_on: the same run to its stop, then exactly run_on iterations more at that
+// resolution with every rule off, ending with the stop's status.
+TEST(Refiner, RunningOnGoesOnFromTheStopAtItsResolution) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = few_iterations(24);
+  options.stopping.min_iterations = 6;
+  options.stopping.epsilon_percent = 50.0;  // "converged" as soon as the rules may fire
+  const RefineResult stopped = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_TRUE(stopped.summary.status == RefineStatus::Converged || stopped.summary.status == RefineStatus::Settled)
+      << to_string(stopped.summary.status);
+  const auto& before = stopped.summary.iterations;
+  const std::size_t stop = before.size();
+  ASSERT_LT(stop, 24u);
+
+  options.stopping.run_on = 4;
+  const RefineResult ran_on = refine_mesh(s.scene, s.initial, options, {});
+  EXPECT_EQ(ran_on.summary.status, stopped.summary.status);
+  const auto& after = ran_on.summary.iterations;
+  ASSERT_EQ(after.size(), stop + 4);
+  for (std::size_t i = 0; i + 1 < stop; ++i) {  // the same run up to the stop, bit for bit
+    EXPECT_EQ(after[i].sum_g, before[i].sum_g) << "iteration " << i + 1;
+    EXPECT_EQ(after[i].stop, before[i].stop) << "iteration " << i + 1;
+  }
+  EXPECT_EQ(after[stop - 1].sum_g, before[stop - 1].sum_g);
+  EXPECT_EQ(after[stop - 1].stop, "run on (" + before[stop - 1].stop + ")");
+  for (std::size_t i = stop; i < after.size(); ++i) {
+    EXPECT_EQ(after[i].stop, "running on") << "iteration " << i + 1;
+    EXPECT_EQ(after[i].vertices, before.back().vertices) << "iteration " << i + 1;  // nothing refined
+    EXPECT_EQ(after[i].refined_faces, 0u) << "iteration " << i + 1;
+  }
+  EXPECT_NE(positions(ran_on), positions(stopped));  // the flow went on
+
+  // A budget that ends at the stop does not bound the running on: every stop gets as many more.
+  options.stopping.max_iterations = static_cast<int>(stop);
+  const RefineResult at_budget = refine_mesh(s.scene, s.initial, options, {});
+  EXPECT_EQ(at_budget.summary.iterations.size(), stop + 4);
+  EXPECT_EQ(at_budget.summary.status, stopped.summary.status);
+}
+
+// StoppingOptions::average_last: the result is the mean of the last iterates. Runs of K − 1 and
+// K iterations give those two iterates (no rule may fire earlier, nothing is refined), so the run
+// of K iterations averaging 2 must return their mean, vertex by vertex.
+TEST(Refiner, TheResultIsTheMeanOfTheLastIterates) {
+  const SmallScene& s = small_scene();
+  const auto run = [&](int iterations, int average_last) {
+    RefineOptions options = few_iterations(iterations);
+    options.stopping.min_iterations = iterations;  // no stop, so no refinement, before the budget
+    options.stopping.average_last = average_last;
+    const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
+    EXPECT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+    EXPECT_EQ(result.summary.iterations.size(), static_cast<std::size_t>(iterations));
+    return result;
+  };
+  const RefineResult last = run(8, 1), before_last = run(7, 1), averaged = run(8, 2);
+  ASSERT_EQ(last.summary.iterations.back().vertices, before_last.summary.iterations.back().vertices);
+  EXPECT_EQ(last.summary.untangled_pairs, 0u);  // the end's untangling moved nothing
+  const std::vector<Eigen::Vector3d> a = positions(last), b = positions(before_last), mean = positions(averaged);
+  ASSERT_EQ(mean.size(), a.size());
+  double largest_step = 0.0;
+  for (std::size_t v = 0; v < a.size(); ++v) {
+    EXPECT_EQ(mean[v], ((a[v] + b[v]) / 2.0).eval()) << "vertex " << v;
+    largest_step = std::max(largest_step, (a[v] - b[v]).norm());
+  }
+  EXPECT_GT(largest_step, 0.0);  // the two iterates differ: the mean is not either of them
+}
+
 TEST(Refiner, CancelFromOnIterationStopsBeforeTheNextIteration) {
   const SmallScene& s = small_scene();
   std::atomic<bool> cancel{false};

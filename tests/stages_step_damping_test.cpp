@@ -14,6 +14,7 @@
 #include "stages/flow/speed.h"  // compute_local_edges, median_of
 #include "stages/flow/step_damping.h"
 #include "stages/flow/step_momentum.h"
+#include "stages/flow/stopping.h"
 #include "stages_meshes.h"
 
 namespace mvflow {
@@ -310,6 +311,45 @@ TEST(NetNormalMove, PersistenceIsTheShareOfTheLastWindowsMoveThatCarriesOn) {
   EXPECT_TRUE(std::isnan(still.last_persistence()));
   still.record(at_radius(1.005), fields);
   EXPECT_NEAR(still.last_persistence(), 1.0, 1e-9);
+}
+
+// The mean of the last positions: on a sphere stepping 1.01 / 0.99 / 1.01 … in turn, the mean of
+// the last two is the unit sphere, of the last three the sphere of radius (1.01 + 0.99 + 1.01)/3.
+TEST(NetNormalMove, TheMeanOfTheLastPositionsCancelsABackAndForth) {
+  const TriMesh base = icosphere(1.0, 2);
+  const VertexFields fields = sphere_fields(base);
+  const auto at_radius = [&](double radius) {
+    TriMesh mesh = base;
+    scale_sphere(mesh, radius);
+    return mesh;
+  };
+  NetNormalMove net(2);  // a ring of 5 positions
+  std::vector<Eigen::Vector3d> mean;
+  EXPECT_FALSE(net.mean_of_last(1, mean));
+  for (int i = 0; i < 7; ++i) {
+    net.record(at_radius(i % 2 ? 0.99 : 1.01), fields);
+    EXPECT_EQ(net.mean_of_last(2, mean), i >= 1) << i;
+  }
+  // The last recorded (i = 6) is at 1.01, the one before at 0.99.
+  ASSERT_TRUE(net.mean_of_last(2, mean));
+  ASSERT_EQ(mean.size(), base.n_vertices());
+  for (auto v : base.vertices()) EXPECT_NEAR((mean[v.idx()] - to_eigen(base.point(v))).norm(), 0.0, 1e-15);
+  ASSERT_TRUE(net.mean_of_last(3, mean));
+  for (auto v : base.vertices())
+    EXPECT_NEAR((mean[v.idx()] - to_eigen(base.point(v)) * (1.01 + 0.99 + 1.01) / 3).norm(), 0.0, 1e-15);
+  ASSERT_TRUE(net.mean_of_last(1, mean));
+  for (auto v : base.vertices()) EXPECT_NEAR((mean[v.idx()] - to_eigen(base.point(v)) * 1.01).norm(), 0.0, 1e-15);
+  EXPECT_THROW(net.mean_of_last(0, mean), Error);
+  EXPECT_THROW(net.mean_of_last(6, mean), Error);  // more than the ring holds
+  // After a reset (a new topology) only what was recorded since counts; mean stays as it was.
+  net.reset();
+  net.record(at_radius(1.0), fields);
+  const std::vector<Eigen::Vector3d> before = mean;
+  EXPECT_FALSE(net.mean_of_last(2, mean));
+  EXPECT_EQ(mean, before);
+  EXPECT_THROW((StoppingOptions{.average_last = 0}).check(), OptionError);
+  EXPECT_THROW((StoppingOptions{.lookback = 5, .average_last = 12}).check(), OptionError);
+  EXPECT_NO_THROW((StoppingOptions{.lookback = 5, .average_last = 11}).check());
 }
 
 }  // namespace

@@ -33,6 +33,9 @@
 # 0.9999: a change that moves no vertex measurably in one iteration, which shows the yardstick's
 # own spread (README "Quality": up to 37 % on a peanut). --compare with comma-separated tags
 # compares, per scene, the mean of each side's runs, e.g. --compare A,A.vp,A.vm B,B.vp,B.vm.
+# Issue 12's item 4 (a stop no worse than running on): the same TAG's runs with `-- --run-on 30`
+# (the run goes on 30 iterations from its stop, every rule off), e.g. TAG.on30, then
+# --compare TAG TAG.on30 (README "Convergence", session 40).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 mvflow=${MVFLOW:-$root/build/tools/mvflow}  # MVFLOW: another build

@@ -294,6 +294,16 @@ std::vector<RefineOptionEntry> make_table() {
                     "carries on from one window of iterations to the next, for at most this many times the "
                     "iterations the level ran to its first stop (0 = no wait, the thesis preset; README \"Convergence\")",
                     [](auto& o) -> auto& { return o.stopping.persistence_wait; }));
+  t.push_back(value("--average-last", "average_last", "stopping.average_last",
+                    "The refined mesh is the mean of the positions of the last this many iterations (of the last "
+                    "topology), which cancels the vertices' back-and-forth about the minimum of g (1 = the last "
+                    "iteration, the thesis preset; README \"Convergence\")",
+                    [](auto& o) -> auto& { return o.stopping.average_last; }));
+  t.push_back(value("--run-on", "run_on", "stopping.run_on",
+                    "After the run would end converged or settled, this many more iterations with every stopping "
+                    "rule off and nothing refined (outside the budget): whether the stop came too early (0 = none; "
+                    "README \"Convergence\")",
+                    [](auto& o) -> auto& { return o.stopping.run_on; }));
   t.push_back(switch_flag("--no-remeshing", "global_remeshing", "Skip the global split/collapse before the flow",
                           [](auto& o) -> auto& { return o.global_remeshing; }, false));
   t.push_back(value("--refine-min-pixels", "adaptive_min_edge_pixels", "adaptive.min_edge_pixels",

@@ -242,8 +242,8 @@ class Refinement {
       report.iteration = iteration;
       double refinement_seconds = 0.0;
       // Refinement waits for the full-resolution images with either schedule.
-      const bool refine_now =
-          options_.refinement_schedule == RefinementSchedule::EveryIteration && iteration > 1 && levels_.empty();
+      const bool refine_now = options_.refinement_schedule == RefinementSchedule::EveryIteration && iteration > 1 &&
+                              levels_.empty() && !running_on_;
       if ((refine_now && adapt(report, refinement_seconds)) || !data_.surface) {
         data_.reset_topology();
         graph_.reset();
@@ -269,13 +269,22 @@ class Refinement {
                                                    data_.net_move_over_edge);
       report.stop = to_string(reason);
       const bool budget_left = stopping.iterations() < static_cast<std::size_t>(options_.stopping.max_iterations);
-      if (budget_left && !finest_wait_.reached() && refine_at_convergence(reason, report)) {
+      if (running_on_) {  // StoppingOptions::run_on: every rule off, nothing refined
+        report.stop = "running on";
+        reason = --run_on_left_ > 0 ? StopReason::Continue : run_on_from_;
+      } else if (budget_left && !finest_wait_.reached() && refine_at_convergence(reason, report)) {
         stopping.restart();
         reason = StopReason::Continue;
       } else if (reason != StopReason::Continue && reason != StopReason::MaxIterations &&
                  finest_wait_.wait(options_.stopping, reason, data_.net_move.last_persistence(),
                                    stopping.level_iterations(), budget_left)) {
         report.stop = std::string("held (") + to_string(reason) + ")";
+        reason = StopReason::Continue;
+      } else if (reason != StopReason::Continue && reason != StopReason::MaxIterations && options_.stopping.run_on > 0) {
+        report.stop = std::string("run on (") + to_string(reason) + ")";
+        running_on_ = true;
+        run_on_left_ = options_.stopping.run_on;
+        run_on_from_ = reason;
         reason = StopReason::Continue;
       }
       summary.iterations.push_back(report);
@@ -287,6 +296,14 @@ class Refinement {
     }
 
     progress(static_cast<int>(summary.iterations.size()), RefineStage::Finishing);
+    // The result is the mean of the last iterates (StoppingOptions::average_last), before the
+    // end's spread and untangling, which act on it as they would on the last iterate.
+    if (status != RefineStatus::Cancelled && options_.stopping.average_last > 1) {
+      std::vector<Eigen::Vector3d> mean;
+      if (data_.net_move.mean_of_last(static_cast<std::size_t>(options_.stopping.average_last), mean) &&
+          mean.size() == mesh_.n_vertices())
+        set_positions(mesh_, mean);
+    }
     // At convergence the spread runs before each refinement (refine_at_convergence); refined every
     // iteration, once here.
     if (status != RefineStatus::Cancelled && options_.refinement_schedule == RefinementSchedule::EveryIteration)
@@ -318,7 +335,7 @@ class Refinement {
     if (!control_.on_progress) return;
     RefineProgress p;
     p.iteration = iteration;
-    p.max_iterations = options_.stopping.max_iterations;
+    p.max_iterations = options_.stopping.max_iterations + options_.stopping.run_on;  // the bound with running on
     p.vertices = mesh_.n_vertices();
     p.stage = stage;
     control_.on_progress(p);
@@ -558,7 +575,7 @@ class Refinement {
                             report.max_speed, report.seconds);
     RefineProgress p;
     p.iteration = report.iteration;
-    p.max_iterations = options_.stopping.max_iterations;
+    p.max_iterations = options_.stopping.max_iterations + options_.stopping.run_on;  // the bound with running on
     p.vertices = report.vertices;
     p.sum_g_per_vertex = report.sum_g_per_vertex();
     p.stage = RefineStage::Iterating;
@@ -599,6 +616,10 @@ class Refinement {
   int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
   //! Whether a stop found nothing left to refine, and the wait there (StoppingOptions::persistence_wait).
   FinestResolutionWait finest_wait_;
+  //! StoppingOptions::run_on: whether the run is past its stop, the iterations left, that stop.
+  bool running_on_ = false;
+  int run_on_left_ = 0;
+  StopReason run_on_from_ = StopReason::Continue;
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
   //! Of those, only the hardly observed (the spread is auto without rims: spread_fraction()).
   bool spreads_hardly_observed_ = false;

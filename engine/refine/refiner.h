@@ -23,7 +23,7 @@ const char* to_string(RefineStage stage);  //!< "preparing", "iterating", "finis
 //! Where the refinement stands, for progress displays.
 struct RefineProgress {
   int iteration = 0;          //!< 0 while preparing
-  int max_iterations = 0;
+  int max_iterations = 0;     //!< the budget, plus StoppingOptions::run_on: no run goes past it
   std::size_t vertices = 0;
   double sum_g_per_vertex = 0.0;
   RefineStage stage = RefineStage::Preparing;

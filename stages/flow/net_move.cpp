@@ -65,4 +65,18 @@ double NetNormalMove::record(const TriMesh& mesh, const VertexFields& fields) {
   return median_of(std::move(relative));
 }
 
+bool NetNormalMove::mean_of_last(std::size_t count, std::vector<Eigen::Vector3d>& mean) const {
+  const std::size_t slots = ring_.size();
+  MVFLOW_CHECK(count >= 1 && count <= slots, "NetNormalMove: mean_of_last needs 1 to 2·window + 1 positions");
+  if (recorded_ < count) return false;
+  const std::vector<Eigen::Vector3d>& newest = ring_[(next_ + slots - 1) % slots];
+  mean = newest;
+  for (std::size_t back = 2; back <= count; ++back) {
+    const std::vector<Eigen::Vector3d>& earlier = ring_[(next_ + slots - back) % slots];
+    for (std::size_t v = 0; v < mean.size(); ++v) mean[v] += earlier[v];
+  }
+  for (Eigen::Vector3d& p : mean) p /= static_cast<double>(count);
+  return true;
+}
+
 }  // namespace mvflow

@@ -54,6 +54,12 @@ class NetNormalMove {
 
   int window() const { return window_; }
 
+  //! The mean, vertex by vertex, of the last \p count recorded positions of this topology (the
+  //! newest first, summed in that order), into \p mean; false, and \p mean untouched, when fewer
+  //! were recorded since the reset. 1 ≤ count ≤ 2·window + 1.
+  //! \throw Error if count is out of that range.
+  bool mean_of_last(std::size_t count, std::vector<Eigen::Vector3d>& mean) const;
+
  private:
   int window_;
   std::vector<std::vector<Eigen::Vector3d>> ring_;  // 2·window + 1 slots, the oldest at next_

@@ -38,6 +38,9 @@ void StoppingOptions::check() const {
                  ">= 0 and finite");
   require_option(persistence_wait >= 0.0 && std::isfinite(persistence_wait), "persistence_wait", persistence_wait,
                  ">= 0 and finite");
+  require_option(run_on >= 0, "run_on", run_on, ">= 0");
+  require_option(average_last >= 1 && average_last <= 2 * lookback + 1, "average_last", average_last,
+                 "in [1, 2·lookback + 1] (" + std::to_string(2 * lookback + 1) + ")");
   require_option(settled_noise_reference >= 0.0 && std::isfinite(settled_noise_reference), "settled_noise_reference",
                  settled_noise_reference, ">= 0 and finite");
 }

@@ -78,6 +78,20 @@ struct StoppingOptions {
   //! keeps photographs, whose tail creeps for 100 iterations and more, inside the budget. ≥ 0 (0:
   //! no wait, the thesis preset). 1: README, "Convergence".
   double persistence_wait = 1.0;
+  //! The run's result is the mean of the positions of its last average_last iterations (one
+  //! topology): at a stop many vertices step back and forth about the minimum of g from one
+  //! iteration to the next (the error of w1's stop and the next iteration 0.00118 / 0.00114 /
+  //! 0.00119 …), and the mean of two iterates cancels that (0.00110). Fewer iterations of the last
+  //! topology (a refinement just before the end): the last positions. In [1, 2·lookback + 1];
+  //! 1 = the last iterate (the thesis preset). README, "Convergence".
+  int average_last = 2;
+  //! Running on, the yardstick of "converged" (issue 12's item 4: a stop is no worse than running
+  //! on): after the run would end converged, step-small or settled, this many more iterations
+  //! with every stopping rule off and nothing refined, then the run ends with the status of that
+  //! stop (the report marks it "run on (…)"); the iteration budget does not bound them, so every
+  //! stop is compared with the same number of iterations more. ≥ 0 (0: none, the default).
+  //! README, "Convergence".
+  int run_on = 0;
 
   //! \throw OptionError naming the first field out of range, its value and its valid values.
   void check() const;
