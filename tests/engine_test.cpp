@@ -80,15 +80,22 @@ RefineOptions few_iterations(int iterations) {
   return options;
 }
 
+// A budget of \p iterations in which the flow counts as "converged" as soon as the rules may fire
+// (after 6 iterations), so that it refines within the run.
+RefineOptions converging_early(int iterations) {
+  RefineOptions options = few_iterations(iterations);
+  options.stopping.min_iterations = 6;
+  options.stopping.epsilon_percent = 50.0;
+  return options;
+}
+
 std::vector<Eigen::Vector3d> positions(const RefineResult& result) { return positions_of(result.mesh.topology); }
 
 // Both time-step rules and both refinement schedules: the default (quantile step, local CFL
 // bound, refinement when the flow has converged, which the short minimum lets happen within the
 // run) and the thesis's (max|F|, global bound, refinement before every iteration).
 std::vector<RefineOptions> determinism_cases() {
-  RefineOptions by_default = few_iterations(12);
-  by_default.stopping.min_iterations = 6;
-  by_default.stopping.epsilon_percent = 50.0;  // "converged" early, so it refines within the run
+  RefineOptions by_default = converging_early(12);  // so it refines within the run
   RefineOptions thesis_rules = few_iterations(6);
   thesis_rules.speed_quantile = 1.0;
   thesis_rules.local_step = false;
@@ -305,9 +312,7 @@ TEST(Refiner, ReportsTheVerticesWhoseGLaidItsPatchOnTheSurfaceAndTheSwitches) {
 
 TEST(Refiner, RefinesCoarseToFineWhenTheFlowHasConverged) {
   const SmallScene& s = small_scene();
-  RefineOptions options = few_iterations(16);
-  options.stopping.min_iterations = 6;
-  options.stopping.epsilon_percent = 50.0;  // "converged" as soon as the rules may fire
+  RefineOptions options = converging_early(16);
   const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
   ASSERT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
   const auto& iterations = result.summary.iterations;
@@ -330,9 +335,7 @@ TEST(Refiner, RefinesCoarseToFineWhenTheFlowHasConverged) {
 
 TEST(Refiner, CoarserImagesFirstThenTheFullOnesThenRefinement) {
   const SmallScene& s = small_scene();
-  RefineOptions options = few_iterations(20);
-  options.stopping.min_iterations = 6;
-  options.stopping.epsilon_percent = 50.0;  // "converged" as soon as the rules may fire
+  RefineOptions options = converging_early(20);
   options.image_levels = 2;
   const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
   ASSERT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
@@ -361,9 +364,7 @@ TEST(Refiner, ARefinementBelowTheMinimumGrowthEndsTheRun) {
   // Reference: every refinement done (min_growth 0). The first refinement that adds fewer than
   // 60 % vertices adds `added` to `before`; the ones before it grew the mesh more.
   const SmallScene& s = small_scene();
-  RefineOptions options = few_iterations(24);
-  options.stopping.min_iterations = 6;
-  options.stopping.epsilon_percent = 50.0;  // "converged" as soon as the rules may fire
+  RefineOptions options = converging_early(24);
   options.adaptive.min_growth = 0.0;
   const RefineResult every = refine_mesh(s.scene, s.initial, options, {});
   ASSERT_NE(every.summary.status, RefineStatus::Failed) << every.summary.message;
@@ -411,9 +412,7 @@ TEST(Refiner, ARefinementBelowTheMinimumGrowthEndsTheRun) {
 // resolution with every rule off, ending with the stop's status.
 TEST(Refiner, RunningOnGoesOnFromTheStopAtItsResolution) {
   const SmallScene& s = small_scene();
-  RefineOptions options = few_iterations(24);
-  options.stopping.min_iterations = 6;
-  options.stopping.epsilon_percent = 50.0;  // "converged" as soon as the rules may fire
+  RefineOptions options = converging_early(24);
   const RefineResult stopped = refine_mesh(s.scene, s.initial, options, {});
   ASSERT_TRUE(stopped.summary.status == RefineStatus::Converged || stopped.summary.status == RefineStatus::Settled)
       << to_string(stopped.summary.status);

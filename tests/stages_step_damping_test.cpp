@@ -217,6 +217,13 @@ void scale_sphere(TriMesh& mesh, double factor) {
   for (auto v : mesh.vertices()) mesh.set_point(v, mesh.point(v) * factor);
 }
 
+// A copy of \p base scaled by \p factor about the origin.
+TriMesh scaled(const TriMesh& base, double factor) {
+  TriMesh mesh = base;
+  scale_sphere(mesh, factor);
+  return mesh;
+}
+
 TEST(NetNormalMove, IsTheRadialGrowthOverTheWindowInShortestEdges) {
   TriMesh mesh = icosphere(1.0, 3);
   const VertexFields fields = sphere_fields(mesh);
@@ -265,11 +272,7 @@ TEST(NetNormalMove, IsTheRadialGrowthOverTheWindowInShortestEdges) {
 TEST(NetNormalMove, PersistenceIsTheShareOfTheLastWindowsMoveThatCarriesOn) {
   const TriMesh base = icosphere(1.0, 3);
   const VertexFields fields = sphere_fields(base);
-  const auto at_radius = [&](double radius) {
-    TriMesh mesh = base;
-    scale_sphere(mesh, radius);
-    return mesh;
-  };
+  const auto at_radius = [&](double radius) { return scaled(base, radius); };
   // A creep slowing geometrically, r_i = 1 + 0.01·(1 − q^i): over one window of 5 every vertex
   // moves q^5 times its move over the window before, so Σ a·b / Σ b² = q^5 whatever the edges.
   constexpr double q = 0.9;
@@ -318,11 +321,7 @@ TEST(NetNormalMove, PersistenceIsTheShareOfTheLastWindowsMoveThatCarriesOn) {
 TEST(NetNormalMove, TheMeanOfTheLastPositionsCancelsABackAndForth) {
   const TriMesh base = icosphere(1.0, 2);
   const VertexFields fields = sphere_fields(base);
-  const auto at_radius = [&](double radius) {
-    TriMesh mesh = base;
-    scale_sphere(mesh, radius);
-    return mesh;
-  };
+  const auto at_radius = [&](double radius) { return scaled(base, radius); };
   NetNormalMove net(2);  // a ring of 5 positions
   std::vector<Eigen::Vector3d> mean;
   EXPECT_FALSE(net.mean_of_last(1, mean));
