@@ -300,7 +300,7 @@ std::vector<RefineOptionEntry> make_table() {
                     "iteration, the thesis preset; README \"Convergence\")",
                     [](auto& o) -> auto& { return o.stopping.average_last; }));
   t.push_back(value("--run-on", "run_on", "stopping.run_on",
-                    "After the run would end converged or settled, this many more iterations with every stopping "
+                    "After the run would end converged, step-small or settled, this many more iterations with every stopping "
                     "rule off and nothing refined (outside the budget): whether the stop came too early (0 = none; "
                     "README \"Convergence\")",
                     [](auto& o) -> auto& { return o.stopping.run_on; }));

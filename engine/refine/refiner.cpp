@@ -301,8 +301,11 @@ class Refinement {
     if (status != RefineStatus::Cancelled && options_.stopping.average_last > 1) {
       std::vector<Eigen::Vector3d> mean;
       if (data_.net_move.mean_of_last(static_cast<std::size_t>(options_.stopping.average_last), mean) &&
-          mean.size() == mesh_.n_vertices())
+          mean.size() == mesh_.n_vertices()) {
+        const std::vector<Eigen::Vector3d> last = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
         set_positions(mesh_, mean);
+        limit_to_silhouettes(last);  // a mean of two inside positions may leave a concave silhouette
+      }
     }
     // At convergence the spread runs before each refinement (refine_at_convergence); refined every
     // iteration, once here.
@@ -331,11 +334,18 @@ class Refinement {
  private:
   bool cancelled() const { return control_.cancel && control_.cancel->load(); }
 
+  // No run goes past the budget plus the running on (an int, saturated).
+  int iteration_bound() const {
+    return static_cast<int>(std::min<long long>(std::numeric_limits<int>::max(),
+                                                static_cast<long long>(options_.stopping.max_iterations) +
+                                                    options_.stopping.run_on));
+  }
+
   void progress(int iteration, RefineStage stage) {
     if (!control_.on_progress) return;
     RefineProgress p;
     p.iteration = iteration;
-    p.max_iterations = options_.stopping.max_iterations + options_.stopping.run_on;  // the bound with running on
+    p.max_iterations = iteration_bound();
     p.vertices = mesh_.n_vertices();
     p.stage = stage;
     control_.on_progress(p);
@@ -575,7 +585,7 @@ class Refinement {
                             report.max_speed, report.seconds);
     RefineProgress p;
     p.iteration = report.iteration;
-    p.max_iterations = options_.stopping.max_iterations + options_.stopping.run_on;  // the bound with running on
+    p.max_iterations = iteration_bound();
     p.vertices = report.vertices;
     p.sum_g_per_vertex = report.sum_g_per_vertex();
     p.stage = RefineStage::Iterating;

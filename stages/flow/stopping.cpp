@@ -38,9 +38,11 @@ void StoppingOptions::check() const {
                  ">= 0 and finite");
   require_option(persistence_wait >= 0.0 && std::isfinite(persistence_wait), "persistence_wait", persistence_wait,
                  ">= 0 and finite");
-  require_option(run_on >= 0, "run_on", run_on, ">= 0");
-  require_option(average_last >= 1 && average_last <= 2 * lookback + 1, "average_last", average_last,
-                 "in [1, 2·lookback + 1] (" + std::to_string(2 * lookback + 1) + ")");
+  // Bounded so that max_iterations + run_on (the progress's bound) stays an int.
+  require_option(run_on >= 0 && run_on <= 1000000, "run_on", run_on, "in [0, 1000000]");
+  const long long ring = 2LL * lookback + 1;  // NetNormalMove's positions
+  require_option(average_last >= 1 && average_last <= ring, "average_last", average_last,
+                 "in [1, 2·lookback + 1] (" + std::to_string(ring) + ")");
   require_option(settled_noise_reference >= 0.0 && std::isfinite(settled_noise_reference), "settled_noise_reference",
                  settled_noise_reference, ">= 0 and finite");
 }

@@ -89,7 +89,7 @@ struct StoppingOptions {
   //! on): after the run would end converged, step-small or settled, this many more iterations
   //! with every stopping rule off and nothing refined, then the run ends with the status of that
   //! stop (the report marks it "run on (…)"); the iteration budget does not bound them, so every
-  //! stop is compared with the same number of iterations more. ≥ 0 (0: none, the default).
+  //! stop is compared with the same number of iterations more. In [0, 1000000] (0: none, the default).
   //! README, "Convergence".
   int run_on = 0;
 
