@@ -243,7 +243,7 @@ class Refinement {
       double refinement_seconds = 0.0;
       // Refinement waits for the full-resolution images with either schedule.
       const bool refine_now = options_.refinement_schedule == RefinementSchedule::EveryIteration && iteration > 1 &&
-                              levels_.empty() && !running_on_;
+                              levels_.empty() && run_on_left_ == 0;
       if ((refine_now && adapt(report, refinement_seconds)) || !data_.surface) {
         data_.reset_topology();
         graph_.reset();
@@ -269,20 +269,19 @@ class Refinement {
                                                    data_.net_move_over_edge);
       report.stop = to_string(reason);
       const bool budget_left = stopping.iterations() < static_cast<std::size_t>(options_.stopping.max_iterations);
-      if (running_on_) {  // StoppingOptions::run_on: every rule off, nothing refined
+      const bool rule_fired = reason != StopReason::Continue && reason != StopReason::MaxIterations;
+      if (run_on_left_ > 0) {  // StoppingOptions::run_on: every rule off, nothing refined
         report.stop = "running on";
         reason = --run_on_left_ > 0 ? StopReason::Continue : run_on_from_;
       } else if (budget_left && !finest_wait_.reached() && refine_at_convergence(reason, report)) {
         stopping.restart();
         reason = StopReason::Continue;
-      } else if (reason != StopReason::Continue && reason != StopReason::MaxIterations &&
-                 finest_wait_.wait(options_.stopping, reason, data_.net_move.last_persistence(),
-                                   stopping.level_iterations(), budget_left)) {
+      } else if (rule_fired && finest_wait_.wait(options_.stopping, reason, data_.net_move.last_persistence(),
+                                                 stopping.level_iterations(), budget_left)) {
         report.stop = std::string("held (") + to_string(reason) + ")";
         reason = StopReason::Continue;
-      } else if (reason != StopReason::Continue && reason != StopReason::MaxIterations && options_.stopping.run_on > 0) {
+      } else if (rule_fired && options_.stopping.run_on > 0) {
         report.stop = std::string("run on (") + to_string(reason) + ")";
-        running_on_ = true;
         run_on_left_ = options_.stopping.run_on;
         run_on_from_ = reason;
         reason = StopReason::Continue;
@@ -296,17 +295,8 @@ class Refinement {
     }
 
     progress(static_cast<int>(summary.iterations.size()), RefineStage::Finishing);
-    // The result is the mean of the last iterates (StoppingOptions::average_last), before the
-    // end's spread and untangling, which act on it as they would on the last iterate.
-    if (status != RefineStatus::Cancelled && options_.stopping.average_last > 1) {
-      std::vector<Eigen::Vector3d> mean;
-      if (data_.net_move.mean_of_last(static_cast<std::size_t>(options_.stopping.average_last), mean) &&
-          mean.size() == mesh_.n_vertices()) {
-        const std::vector<Eigen::Vector3d> last = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
-        set_positions(mesh_, mean);
-        limit_to_silhouettes(last);  // a mean of two inside positions may leave a concave silhouette
-      }
-    }
+    // Before the end's spread and untangling, which act on the mean as on the last iterate.
+    if (status != RefineStatus::Cancelled) average_last_iterates();
     // At convergence the spread runs before each refinement (refine_at_convergence); refined every
     // iteration, once here.
     if (status != RefineStatus::Cancelled && options_.refinement_schedule == RefinementSchedule::EveryIteration)
@@ -445,6 +435,17 @@ class Refinement {
                             result.crossing_pairs_before, result.crossing_pairs_after, result.smoothed_vertices,
                             result.rounds);
     return result;
+  }
+
+  // The result is the mean of the last iterates of this topology (StoppingOptions::average_last);
+  // the last iterate where fewer were recorded (a refinement just before the end).
+  void average_last_iterates() {
+    if (options_.stopping.average_last < 2) return;
+    std::vector<Eigen::Vector3d> mean;
+    if (!data_.net_move.mean_of_last(static_cast<std::size_t>(options_.stopping.average_last), mean)) return;
+    const std::vector<Eigen::Vector3d> last = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
+    set_positions(mesh_, mean);
+    limit_to_silhouettes(last);  // a mean of two inside positions may leave a concave silhouette
   }
 
   // The silhouette constraint holds for the moves outside the flow too: each vertex moved since
@@ -626,8 +627,7 @@ class Refinement {
   int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
   //! Whether a stop found nothing left to refine, and the wait there (StoppingOptions::persistence_wait).
   FinestResolutionWait finest_wait_;
-  //! StoppingOptions::run_on: whether the run is past its stop, the iterations left, that stop.
-  bool running_on_ = false;
+  //! StoppingOptions::run_on: the iterations left past the stop (0: not running on), that stop.
   int run_on_left_ = 0;
   StopReason run_on_from_ = StopReason::Continue;
   bool spreads_ = false;  //!< the unobserved vertices follow the observed surface (UnobservedSpread)
