@@ -472,6 +472,114 @@ TEST(Refiner, TheResultIsTheMeanOfTheLastIterates) {
   EXPECT_GT(largest_step, 0.0);  // the two iterates differ: the mean is not either of them
 }
 
+// The iterates averaged are of one set of images: a switch to finer images (image_levels) starts
+// them afresh, so a run whose budget ends one iteration after the switch ends on its last iterate.
+TEST(Refiner, SwitchingToFinerImagesStartsTheAveragingAfresh) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = converging_early(30);
+  options.image_levels = 1;
+  options.adaptive_refinement = false;
+  const RefineResult probe = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_NE(probe.summary.status, RefineStatus::Failed) << probe.summary.message;
+  std::size_t switched = 0;  // iterations up to and including the switch
+  for (const IterationReport& r : probe.summary.iterations)
+    if (r.stop.starts_with("finer images (")) switched = static_cast<std::size_t>(r.iteration);
+  ASSERT_GT(switched, 0u) << "no switch to the full images";
+  options.stopping.max_iterations = static_cast<int>(switched) + 1;
+  options.stopping.average_last = 2;
+  const RefineResult averaged = refine_mesh(s.scene, s.initial, options, {});
+  options.stopping.average_last = 1;
+  const RefineResult last = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_EQ(averaged.summary.iterations.size(), switched + 1);
+  EXPECT_TRUE(averaged.summary.iterations[switched - 1].stop.starts_with("finer images ("));
+  EXPECT_EQ(positions(averaged), positions(last));
+}
+
+// With the refinement before every iteration, a run whose last iteration refined has one iterate
+// of its last topology: the result is that iterate, as without averaging.
+TEST(Refiner, ARefinementAtTheLastIterationLeavesTheLastIterate) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = few_iterations(6);  // its 6th iteration refines
+  options.stopping.min_iterations = 6;
+  options.refinement_schedule = RefinementSchedule::EveryIteration;
+  options.stopping.average_last = 2;
+  const RefineResult averaged = refine_mesh(s.scene, s.initial, options, {});
+  options.stopping.average_last = 1;
+  const RefineResult last = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_EQ(averaged.summary.iterations.size(), 6u) << averaged.summary.message;
+  ASSERT_GT(averaged.summary.iterations.back().refined_faces, 0u) << "the last iteration did not refine";
+  EXPECT_EQ(positions(averaged), positions(last));
+}
+
+// Running on refines nothing with the refinement before every iteration either.
+TEST(Refiner, RunningOnRefinesNothingWithTheEveryIterationSchedule) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = converging_early(24);
+  options.refinement_schedule = RefinementSchedule::EveryIteration;
+  options.stopping.run_on = 3;
+  const RefineResult result = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+  const auto& iterations = result.summary.iterations;
+  std::size_t stop = 0;
+  for (std::size_t i = 0; i < iterations.size(); ++i)
+    if (iterations[i].stop.starts_with("run on (")) stop = i;
+  ASSERT_GT(stop, 0u) << "no rule fired within the budget";
+  ASSERT_EQ(iterations.size(), stop + 4);
+  bool refined_before = false;
+  for (std::size_t i = 0; i <= stop; ++i) refined_before |= iterations[i].refined_faces > 0;
+  EXPECT_TRUE(refined_before);  // the schedule refines while the flow runs
+  for (std::size_t i = stop + 1; i < iterations.size(); ++i) {
+    EXPECT_EQ(iterations[i].stop, "running on");
+    EXPECT_EQ(iterations[i].refined_faces, 0u) << "iteration " << i + 1;
+    EXPECT_EQ(iterations[i].vertices, iterations[stop].vertices) << "iteration " << i + 1;
+  }
+}
+
+// A cancel while running on ends the run at once, "cancelled", as anywhere else.
+TEST(Refiner, CancelWhileRunningOnStopsBeforeTheNextIteration) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = converging_early(24);
+  options.stopping.run_on = 10;
+  std::atomic<bool> cancel{false};
+  int running_on = 0;
+  RefineControl control;
+  control.cancel = &cancel;
+  control.on_iteration = [&](const IterationReport& report) {
+    if (report.stop == "running on" && ++running_on == 2) cancel = true;
+  };
+  const RefineResult result = refine_mesh(s.scene, s.initial, options, control);
+  EXPECT_EQ(result.summary.status, RefineStatus::Cancelled);
+  ASSERT_EQ(running_on, 2);
+  EXPECT_EQ(result.summary.iterations.back().stop, "running on");
+}
+
+// The summary counts each fold the untangling removed once. A run that ends at its first stop
+// (no refinement) untangles there, before it knows it ends, and again at its end, on the mean of
+// the iterates recorded before the stop's untangling: only the end's removal counts, so the count
+// is the folds of the same run without untangling less those left. The CFL number 8 folds the
+// small scene within its 6 iterations.
+// Either way the stop's positions are dropped: replaced by the mean, or, where the stop spread the
+// unobserved vertices, restored to the flowed ones before the spread and the untangling.
+TEST(Refiner, FoldsUntangledAtTheLastStopAreCountedOnce) {
+  const SmallScene& s = small_scene();
+  for (const UnobservedSpread spread : {UnobservedSpread::Off, UnobservedSpread::On}) {
+    RefineOptions options = converging_early(30);
+    options.adaptive_refinement = false;
+    options.cfl = 8.0;
+    options.unobserved_displacement.spread = spread;
+    options.untangling.max_rounds = 0;
+    const RefineResult folded = refine_mesh(s.scene, s.initial, options, {});
+    options.untangling.max_rounds = 10;
+    const RefineResult untangled = refine_mesh(s.scene, s.initial, options, {});
+    ASSERT_EQ(untangled.summary.status, RefineStatus::Converged) << untangled.summary.message;
+    ASSERT_EQ(untangled.summary.iterations.size(), folded.summary.iterations.size());
+    ASSERT_GT(folded.summary.self_intersections, 0u) << "no fold to untangle";
+    EXPECT_EQ(untangled.summary.untangled_pairs,
+              folded.summary.self_intersections - untangled.summary.self_intersections)
+        << "spread " << static_cast<int>(spread);
+  }
+}
+
 TEST(Refiner, CancelFromOnIterationStopsBeforeTheNextIteration) {
   const SmallScene& s = small_scene();
   std::atomic<bool> cancel{false};

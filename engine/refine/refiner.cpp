@@ -238,6 +238,7 @@ class Refinement {
         break;
       }
       const auto iteration_start = Clock::now();
+      untangled_at_stop_ = 0;  // the flow goes on from the last stop's untangled positions: they count
       IterationReport report;
       report.iteration = iteration;
       double refinement_seconds = 0.0;
@@ -445,6 +446,7 @@ class Refinement {
     if (!data_.net_move.mean_of_last(static_cast<std::size_t>(options_.stopping.average_last), mean)) return;
     const std::vector<Eigen::Vector3d> last = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     set_positions(mesh_, mean);
+    untangled_pairs_ -= untangled_at_stop_;  // the iterates were recorded before the stop's untangling
     limit_to_silhouettes(last);  // a mean of two inside positions may leave a concave silhouette
   }
 
@@ -527,6 +529,8 @@ class Refinement {
       data_.step_scale = 1.0;  // Σg/vertex on other images says nothing about the steps on these
       data_.previous_g_per_vertex = 0.0;
       data_.damping.reset(mesh_.n_vertices());  // reversals on other images say nothing about these
+      data_.net_move.reset();  // nor do positions on them: no net move or average across images
+      data_.net_move_over_edge = std::numeric_limits<double>::quiet_NaN();
       report.stop = std::string("finer images (") + to_string(reason) + ")";
       if (control_.logger) control_.logger->info("images at 1/{} of their resolution from here", 1 << levels_.size());
       return true;
@@ -535,6 +539,7 @@ class Refinement {
     const auto start = Clock::now();
     const std::vector<Eigen::Vector3d> flowed = spreads_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const bool spread = spread_unobserved(hardly_observed_fraction());
+    const std::size_t untangled_before = untangled_pairs_;
     const std::optional<UntanglingResult> untangled = untangle_folds();
     if (spread || (untangled && untangled->rounds > 0)) update_curvature();  // the marks follow the moves
     double seconds = seconds_since(start);
@@ -544,7 +549,14 @@ class Refinement {
       // The finest resolution: the flow has the last word (the run's end untangles again). A
       // spread is kept only where a refinement and more flow follow it; after the finest level it
       // undid what the flow had recovered of weakly seen regions (README, "Weakly seen regions").
-      if (spread) set_positions(mesh_, flowed);
+      // Restoring the flowed positions undoes the untangling too, so its folds are not counted;
+      // otherwise they count unless the run ends here and the averaging replaces these positions.
+      if (spread) {
+        set_positions(mesh_, flowed);
+        untangled_pairs_ = untangled_before;
+      } else {
+        untangled_at_stop_ = untangled_pairs_ - untangled_before;
+      }
       return false;
     }
     ++mesh_refinements_;
@@ -617,6 +629,9 @@ class Refinement {
   double reference_edge_ = 0.0;
   double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
   std::size_t untangled_pairs_ = 0;
+  //! Of those, the ones removed at a stop that refined nothing, from positions the run's end may
+  //! replace by the mean of the iterates before it (average_last_iterates); 0 once the flow goes on.
+  std::size_t untangled_at_stop_ = 0;
   bool rims_from_masks_ = false;  //!< the silhouettes are the scene's mask images (Scene::masks)
   //! At the run's end the vertices the finest resolution never gave a speed follow too
   //! (UnobservedDisplacementOptions::spread_unmoved).
