@@ -86,6 +86,7 @@ RefineOptions converging_early(int iterations) {
   RefineOptions options = few_iterations(iterations);
   options.stopping.min_iterations = 6;
   options.stopping.epsilon_percent = 50.0;
+  options.stopping.finest_min_iterations = 0;  // the finest resolution too
   return options;
 }
 
@@ -406,6 +407,35 @@ TEST(Refiner, ARefinementBelowTheMinimumGrowthEndsTheRun) {
   ASSERT_GT(accepted.summary.iterations.size(), first + 1);
   EXPECT_EQ(accepted.summary.iterations[first + 1].vertices, before + added);
   EXPECT_EQ(accepted.summary.iterations[first].declined_vertices, 0u);
+}
+
+// StoppingOptions::finest_min_iterations: the finest resolution's stops are held until it has run
+// that many iterations; the coarser resolutions stop as before, so the run is the same up to the
+// finest resolution's first stop.
+TEST(Refiner, TheFinestResolutionRunsAtLeastItsMinimum) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = converging_early(40);
+  const RefineResult early = refine_mesh(s.scene, s.initial, options, {});
+  options.stopping.finest_min_iterations = 12;
+  const RefineResult held = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_NE(early.summary.status, RefineStatus::Failed) << early.summary.message;
+  ASSERT_NE(held.summary.status, RefineStatus::Failed) << held.summary.message;
+  const auto last_level_start = [](const std::vector<IterationReport>& iterations) {
+    std::size_t start = 0;  // index of the first iteration of the last resolution
+    for (std::size_t i = 0; i + 1 < iterations.size(); ++i)
+      if (iterations[i].stop.starts_with("refined (")) start = i + 1;
+    return start;
+  };
+  const auto& a = early.summary.iterations;
+  const auto& b = held.summary.iterations;
+  const std::size_t start = last_level_start(a);
+  ASSERT_GT(start, 0u) << "no refinement";
+  ASSERT_EQ(last_level_start(b), start);
+  EXPECT_LT(a.size() - start, 12u);  // without the minimum the finest resolution stops earlier
+  ASSERT_EQ(b.size() - start, 12u);  // with it, after exactly 12 (every rule fires as soon as it may)
+  for (std::size_t i = 0; i < a.size() - 1; ++i) EXPECT_EQ(a[i].sum_g, b[i].sum_g) << "iteration " << i + 1;
+  EXPECT_TRUE(b[a.size() - 1].stop.starts_with("held (")) << b[a.size() - 1].stop;
+  EXPECT_EQ(held.summary.status, early.summary.status);
 }
 
 // StoppingOptions::run_on: the same run to its stop, then exactly run_on iterations more at that

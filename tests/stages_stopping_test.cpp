@@ -222,6 +222,26 @@ TEST(Stopping, TheFinestResolutionHoldsAConvergedStopWhileTheMovePersists) {
   EXPECT_THROW((StoppingOptions{.persistence_wait = INFINITY}).check(), OptionError);
 }
 
+TEST(Stopping, TheFinestResolutionHoldsAnyRulesStopUntilItsMinimum) {
+  const StoppingOptions options;
+  EXPECT_EQ(options.finest_min_iterations, 15);  // the default; the thesis preset's 0 never holds
+  for (const StopReason reason : {StopReason::Converged, StopReason::StepSmall, StopReason::Settled}) {
+    // Whatever the persistence: a net move that reverses does not end the minimum either.
+    EXPECT_TRUE(holds_at_finest(options, reason, -0.5, 14, 14)) << to_string(reason);
+    EXPECT_FALSE(holds_at_finest(options, reason, -0.5, 15, 14)) << to_string(reason);
+  }
+  EXPECT_FALSE(holds_at_finest(options, StopReason::MaxIterations, -0.5, 10, 10));
+  EXPECT_FALSE(holds_at_finest(options, StopReason::Continue, -0.5, 10, 10));
+  EXPECT_FALSE(holds_at_finest(StoppingOptions{.finest_min_iterations = 0}, StopReason::Settled, -0.5, 3, 3));
+  // Past the minimum, the persistence wait decides, counted from the first stop.
+  EXPECT_TRUE(holds_at_finest(options, StopReason::Converged, 0.2, 17, 10));
+  EXPECT_TRUE(holds_at_finest(options, StopReason::Converged, 0.2, 19, 10));
+  EXPECT_FALSE(holds_at_finest(options, StopReason::Converged, 0.2, 20, 10));
+  FinestResolutionWait no_budget;  // the budget ends the run within the minimum too
+  EXPECT_FALSE(no_budget.wait(options, StopReason::Settled, NAN, 10, false));
+  EXPECT_THROW((StoppingOptions{.finest_min_iterations = -1}).check(), OptionError);
+}
+
 TEST(Stopping, TheFinestResolutionWaitCountsFromItsFirstStop) {
   const StoppingOptions options;  // persistence_wait 1
   FinestResolutionWait wait;
@@ -239,9 +259,9 @@ TEST(Stopping, TheFinestResolutionWaitCountsFromItsFirstStop) {
   EXPECT_FALSE(wait.wait(options, StopReason::Converged, 0.2, 25, false));
   // A first stop that does not wait (settled, or no budget) still marks the finest resolution.
   FinestResolutionWait settled;
-  EXPECT_FALSE(settled.wait(options, StopReason::Settled, 0.2, 12, true));
+  EXPECT_FALSE(settled.wait(options, StopReason::Settled, 0.2, 16, true));
   EXPECT_TRUE(settled.reached());
-  EXPECT_EQ(settled.first_stop(), 12u);
+  EXPECT_EQ(settled.first_stop(), 16u);
   FinestResolutionWait none;
   EXPECT_FALSE(none.wait(StoppingOptions{.persistence_wait = 0.0}, StopReason::Converged, 0.9, 15, true));
   EXPECT_TRUE(none.reached());
