@@ -139,6 +139,20 @@ TEST(RefinePresets, EveryListedNameResolvesAndAnUnknownOneListsThemAll) {
   }
 }
 
+// The thesis preset keeps the thesis's stopping: none of the rules added since (README, "Defaults
+// and differences").
+TEST(RefinePresets, TheThesisPresetStopsAsTheThesis) {
+  const StoppingOptions thesis = preset("thesis").stopping;
+  EXPECT_EQ(thesis.settled_tolerance, 0.0);
+  EXPECT_EQ(thesis.persistence_wait, 0.0);
+  EXPECT_EQ(thesis.finest_min_iterations, 0);
+  EXPECT_EQ(thesis.average_last, 1);
+  EXPECT_EQ(thesis.max_iterations, 100);
+  const StoppingOptions by_default = preset("default").stopping;
+  EXPECT_EQ(by_default.finest_min_iterations, 15);
+  EXPECT_EQ(by_default.average_last, 2);
+}
+
 TEST(RefineOptionTable, EveryEntryIsCovered) {
   EXPECT_EQ(cases().size(), refine_option_table().size());
   for (const RefineOptionEntry& entry : refine_option_table())

@@ -607,7 +607,31 @@ TEST(Refiner, FoldsUntangledAtTheLastStopAreCountedOnce) {
     EXPECT_EQ(untangled.summary.untangled_pairs,
               folded.summary.self_intersections - untangled.summary.self_intersections)
         << "spread " << static_cast<int>(spread);
+    // Keeping the last iterate, the stop's own untangling counts: it did find folds.
+    options.stopping.average_last = 1;
+    const RefineResult last = refine_mesh(s.scene, s.initial, options, {});
+    EXPECT_GT(last.summary.untangled_pairs, 0u) << "spread " << static_cast<int>(spread);
   }
+}
+
+// A stop that untangled and was held (finest_min_iterations) lets the flow go on from the
+// untangled positions; a mean reaching back across that untangling would undo half of it, so a
+// run that ends one iteration later keeps its last iterate, as without averaging.
+TEST(Refiner, TheMeanDoesNotReachBackAcrossAStopsUntangling) {
+  const SmallScene& s = small_scene();
+  RefineOptions options = converging_early(30);
+  options.adaptive_refinement = false;
+  options.cfl = 8.0;  // folds within the first 6 iterations (above)
+  options.unobserved_displacement.spread = UnobservedSpread::Off;
+  options.stopping.finest_min_iterations = 7;  // the stop at 6 is held once
+  const RefineResult averaged = refine_mesh(s.scene, s.initial, options, {});
+  options.stopping.average_last = 1;
+  const RefineResult last = refine_mesh(s.scene, s.initial, options, {});
+  ASSERT_EQ(averaged.summary.iterations.size(), 7u) << averaged.summary.message;
+  EXPECT_TRUE(averaged.summary.iterations[5].stop.starts_with("held (")) << averaged.summary.iterations[5].stop;
+  EXPECT_GT(last.summary.untangled_pairs, 0u);  // the stop untangled
+  EXPECT_EQ(positions(averaged), positions(last));
+  EXPECT_EQ(averaged.summary.untangled_pairs, last.summary.untangled_pairs);
 }
 
 TEST(Refiner, CancelFromOnIterationStopsBeforeTheNextIteration) {

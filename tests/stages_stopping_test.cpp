@@ -224,7 +224,7 @@ TEST(Stopping, TheFinestResolutionHoldsAConvergedStopWhileTheMovePersists) {
 
 TEST(Stopping, TheFinestResolutionHoldsAnyRulesStopUntilItsMinimum) {
   const StoppingOptions options;
-  EXPECT_EQ(options.finest_min_iterations, 15);  // the default; the thesis preset's 0 never holds
+  EXPECT_EQ(options.finest_min_iterations, 15);  // the default (the thesis preset's 0: cli_options_test)
   for (const StopReason reason : {StopReason::Converged, StopReason::StepSmall, StopReason::Settled}) {
     // Whatever the persistence: a net move that reverses does not end the minimum either.
     EXPECT_TRUE(holds_at_finest(options, reason, -0.5, 14, 14)) << to_string(reason);

@@ -300,7 +300,7 @@ std::vector<RefineOptionEntry> make_table() {
                     [](auto& o) -> auto& { return o.stopping.finest_min_iterations; }));
   t.push_back(value("--average-last", "average_last", "stopping.average_last",
                     "The refined mesh is the mean of the positions of the last this many iterations (of the last "
-                    "topology), which cancels the vertices' back-and-forth about the minimum of g (1 = the last "
+                    "topology and images), which cancels the vertices' back-and-forth about the minimum of g (1 = the last "
                     "iteration, the thesis preset; README \"Convergence\")",
                     [](auto& o) -> auto& { return o.stopping.average_last; }));
   t.push_back(value("--run-on", "run_on", "stopping.run_on",

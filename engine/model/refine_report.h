@@ -79,7 +79,7 @@ struct RefineSummary {
   double initial_sum_g_per_vertex = 0.0;  //!< after the global remeshing, before the flow
   double final_sum_g_per_vertex = 0.0;    //!< at the final positions
   std::size_t self_intersections = 0;     //!< pairs of non-adjacent faces that intersect (final mesh)
-  std::size_t untangled_pairs = 0;        //!< crossing face pairs the untangling removed, summed over its calls
+  std::size_t untangled_pairs = 0;        //!< crossing face pairs the untangling removed, over the calls whose positions the result keeps
   double image_noise = 0.0;               //!< the photographs' noise σ (estimate_views_noise; 0 when not estimated)
   //! σ in pixels of the Gaussian the image patches' photographs were blurred with (DenoiseOptions); 0: as given
   double denoise_sigma = 0.0;

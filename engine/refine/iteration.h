@@ -84,7 +84,7 @@ struct IterationData {
   double step_scale = 1.0;   //!< the fraction of the CFL step taken (step control), reset with the topology
   double previous_g_per_vertex = 0.0;  //!< Σg/vertex of the previous iteration on this topology
   StepDampingState damping;  //!< per-vertex step scales (options.damping), reset with the topology
-  NetNormalMove net_move;    //!< positions of the last iterations of this topology and images, for the settled rule
+  NetNormalMove net_move;    //!< positions of the last iterations of this topology and images: settled rule, wait, mean
   //! Set by measure_moves(): the median over the moving vertices of their move divided by the
   //! edge the CFL bound used for them (their own shortest edge, or e_min with the global bound).
   double median_move = 0.0;

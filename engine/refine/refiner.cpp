@@ -429,7 +429,9 @@ class Refinement {
     if (options_.untangling.max_rounds == 0) return std::nullopt;
     const std::vector<Eigen::Vector3d> before = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     const UntanglingResult result = untangle(mesh_, options_.untangling);
-    untangled_pairs_ += result.crossing_pairs_before - result.crossing_pairs_after;
+    // The last round's count: a smoothing that crossed more faces than it freed removed none.
+    if (result.crossing_pairs_before > result.crossing_pairs_after)
+      untangled_pairs_ += result.crossing_pairs_before - result.crossing_pairs_after;
     if (result.rounds > 0) limit_to_silhouettes(before);
     if (control_.logger && result.crossing_pairs_before > 0)
       control_.logger->info("untangled {} crossing face pairs ({} left) by smoothing {} vertices in {} rounds",
@@ -442,8 +444,14 @@ class Refinement {
   // the last iterate where fewer were recorded (a refinement just before the end).
   void average_last_iterates() {
     if (options_.stopping.average_last < 2) return;
+    const auto count = static_cast<std::size_t>(options_.stopping.average_last);
+    // An untangling at a stop the flow went on from lies between the iterates: a mean across it
+    // would undo part of it, so the last iterate stands.
+    const std::size_t recorded = data_.net_move.recorded();
+    if (untangled_after_iterate_ > 0 && untangled_after_iterate_ < recorded && recorded - untangled_after_iterate_ < count)
+      return;
     std::vector<Eigen::Vector3d> mean;
-    if (!data_.net_move.mean_of_last(static_cast<std::size_t>(options_.stopping.average_last), mean)) return;
+    if (!data_.net_move.mean_of_last(count, mean)) return;
     const std::vector<Eigen::Vector3d> last = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     set_positions(mesh_, mean);
     untangled_pairs_ -= untangled_at_stop_;  // the iterates were recorded before the stop's untangling
@@ -556,6 +564,7 @@ class Refinement {
         untangled_pairs_ = untangled_before;
       } else {
         untangled_at_stop_ = untangled_pairs_ - untangled_before;
+        if (untangled && untangled->rounds > 0) untangled_after_iterate_ = data_.net_move.recorded();
       }
       return false;
     }
@@ -632,6 +641,9 @@ class Refinement {
   //! Of those, the ones removed at a stop that refined nothing, from positions the run's end may
   //! replace by the mean of the iterates before it (average_last_iterates); 0 once the flow goes on.
   std::size_t untangled_at_stop_ = 0;
+  //! The iterates net_move had recorded when a stop that refined nothing untangled the positions
+  //! the flow then went on from (0: none): the final mean does not reach back across it.
+  std::size_t untangled_after_iterate_ = 0;
   bool rims_from_masks_ = false;  //!< the silhouettes are the scene's mask images (Scene::masks)
   //! At the run's end the vertices the finest resolution never gave a speed follow too
   //! (UnobservedDisplacementOptions::spread_unmoved).
@@ -640,7 +652,8 @@ class Refinement {
   double denoise_sigma_ = 0.0;  //!< the blur of denoised_ in pixels (0: none)
   double flow_noise_ = 0.0;     //!< the noise the image patches' photographs keep (after the blur)
   int mesh_refinements_ = 0;  //!< refinements at convergence so far (the first resolution until one)
-  //! Whether a stop found nothing left to refine, and the wait there (StoppingOptions::persistence_wait).
+  //! Whether a stop found nothing left to refine, and the wait there (StoppingOptions::
+  //! finest_min_iterations, persistence_wait).
   FinestResolutionWait finest_wait_;
   //! StoppingOptions::run_on: the iterations left past the stop (0: not running on), that stop.
   int run_on_left_ = 0;

@@ -53,6 +53,8 @@ class NetNormalMove {
   double last_persistence() const { return last_persistence_; }
 
   int window() const { return window_; }
+  //! Positions recorded since the last reset.
+  std::size_t recorded() const { return recorded_; }
 
   //! The mean, vertex by vertex, of the last \p count recorded positions of this topology (the
   //! newest first, summed in that order), into \p mean; false, and \p mean untouched, when fewer

@@ -82,7 +82,9 @@ struct StoppingOptions {
   //! level has run this many iterations: there the settled rule fired at its 10-iteration minimum
   //! while the vertices the photographs hardly see (no g: a cap seen at grazing angles) still
   //! closed in, 2 % of the vertices carrying two thirds of what running on gained (the bumpy
-  //! sphere 0.00135 → 0.00129 in the next 5 iterations, 0.00126 after 20 and 60). ≥ 0 (0: no
+  //! sphere 0.00135 → 0.00129 in the next 5 iterations, 0.00126 after 20, 0.00125 after 60). A
+  //! held stop is still the level's first stop for persistence_wait, whose limit counts from it.
+  //! With RefinementSchedule::EveryIteration, which has no levels, the whole run counts. ≥ 0 (0: no
   //! minimum, the thesis preset). 15: 32 scenes × 3 runs 0.996× the error, worse on none, the
   //! longest unit-sphere run 55 iterations; 20 reached 60, issue 12's limit (README,
   //! "Convergence", session 41).
@@ -91,7 +93,8 @@ struct StoppingOptions {
   //! topology): at a stop many vertices step back and forth about the minimum of g from one
   //! iteration to the next (the error of w1's stop and the next iteration 0.00118 / 0.00114 /
   //! 0.00119 …), and the mean of two iterates cancels that (0.00110). Fewer iterations of the last
-  //! topology (a refinement just before the end): the last positions. In [1, 2·lookback + 1];
+  //! topology and images (a refinement or a switch to finer images just before the end), or an
+  //! untangling the flow went on from among them: the last positions. In [1, 2·lookback + 1];
   //! 1 = the last iterate (the thesis preset). README, "Convergence".
   int average_last = 2;
   //! Running on, the yardstick of "converged" (issue 12's item 4: a stop is no worse than running
@@ -120,8 +123,8 @@ double settled_tolerance_for_noise(const StoppingOptions& options, double image_
 bool holds_at_finest(const StoppingOptions& options, StopReason reason, double persistence,
                      std::size_t level_iterations, std::size_t first_stop);
 
-//! The finest resolution's wait (StoppingOptions::persistence_wait) over one run: the refiner
-//! asks it at every stop once a stop has found nothing left to refine.
+//! The finest resolution's wait (StoppingOptions::finest_min_iterations, persistence_wait) over
+//! one run: the refiner asks it at every stop once a stop has found nothing left to refine.
 class FinestResolutionWait {
  public:
   //! A stop has found nothing left to refine: the flow is at its finest resolution, where a stop
