@@ -70,6 +70,7 @@ const std::map<std::string, std::pair<std::string, nlohmann::json>>& cases() {
       {"--settle-noise-reference", {"0.003", 0.003}},
       {"--persistence-wait", {"2.5", 2.5}},
       {"--finest-min-iterations", {"25", 25}},
+      {"--settled-wait", {"0.5", 0.5}},
       {"--run-on", {"30", 30}},
       {"--average-last", {"4", 4}},
       {"--no-remeshing", {"", false}},
@@ -146,6 +147,7 @@ TEST(RefinePresets, TheThesisPresetStopsAsTheThesis) {
   EXPECT_EQ(thesis.settled_tolerance, 0.0);
   EXPECT_EQ(thesis.persistence_wait, 0.0);
   EXPECT_EQ(thesis.finest_min_iterations, 0);
+  EXPECT_EQ(thesis.settled_wait, 0.0);
   EXPECT_EQ(thesis.average_last, 1);
   EXPECT_EQ(thesis.max_iterations, 100);
   const StoppingOptions by_default = preset("default").stopping;
@@ -180,7 +182,7 @@ TEST(RefineOptionTable, BadValuesAreRefusedByTheFlagsChecks) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--engine", "fast"}, {"--patch", "9"}, {"--min-views", "1"}, {"--normalize", "yes"},
         {"--image-levels", "5"}, {"--block-size", "0"}, {"--observed-erode", "-1"}, {"--implausible-g-ratio", "1"}, {"--implausible-speed-rings", "17"}, {"--hardly-observed", "1.5"},
-        {"--hardly-observed-first", "-0.1"}, {"--settle-noise-reference", "-0.001"}, {"--persistence-wait", "-1"}, {"--finest-min-iterations", "-1"}, {"--run-on", "-1"}, {"--run-on", "1000001"},
+        {"--hardly-observed-first", "-0.1"}, {"--settle-noise-reference", "-0.001"}, {"--persistence-wait", "-1"}, {"--finest-min-iterations", "-1"}, {"--settled-wait", "-1"}, {"--run-on", "-1"}, {"--run-on", "1000001"},
         {"--average-last", "0"}, {"--average-last", "12"},
         {"--denoise", "on"}, {"--denoise-reference", "0"}, {"--momentum", "1"},
         {"--far-g-ratio", "0.5"}, {"--far-view-angle", "0"}, {"--far-release", "2"}}) {

@@ -236,10 +236,14 @@ TEST(CliUnobserved, MaskFilesBringTheRimsToATexturedBackground) {
   EXPECT_NE(masked.output.find("unobserved vertices follow the observed surface and the silhouette rims"),
             std::string::npos)
       << masked.output;
-  // Measured: the cap (below −75°) 0.0222 without the masks and the spread, 0.0029 with; between
-  // ±45° 0.0009 and 0.0010.
+  // Measured (session 42): the cap (below −75°) starts at 0.0391 and ends at 0.0028 with the masks;
+  // without them and the spread only smoothing moves it, so its error depends on how long the
+  // finest resolution runs: 0.0095 in 64 iterations (a settled stop waits while the observed
+  // surface still creeps), 0.0166 in 40 without that wait. Between ±45° 0.0008 both ways.
+  const CapErrors start = cap_errors(scene / "init.ply");
   const CapErrors without = cap_errors(folder / "plain.ply"), with = cap_errors(folder / "masked.ply");
-  EXPECT_LT(with.cap, 0.25 * without.cap);
+  EXPECT_LT(with.cap, 0.1 * start.cap);
+  EXPECT_LT(with.cap, 0.5 * without.cap);
   EXPECT_LT(with.observed, 1.3 * without.observed);
   expect_complete(folder / "masked.ply", scene, folder.path());
 

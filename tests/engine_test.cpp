@@ -87,6 +87,7 @@ RefineOptions converging_early(int iterations) {
   options.stopping.min_iterations = 6;
   options.stopping.epsilon_percent = 50.0;
   options.stopping.finest_min_iterations = 0;  // the finest resolution too
+  options.stopping.settled_wait = 0.0;
   return options;
 }
 

@@ -211,7 +211,7 @@ TEST(Stopping, TheFinestResolutionHoldsAConvergedStopWhileTheMovePersists) {
   EXPECT_FALSE(holds_at_finest(on, StopReason::Converged, 0.0, 25, 20));   // moves that do not carry on
   EXPECT_FALSE(holds_at_finest(on, StopReason::Converged, -0.3, 25, 20));  // back and forth
   EXPECT_FALSE(holds_at_finest(on, StopReason::Converged, NAN, 25, 20));   // not yet two windows
-  EXPECT_FALSE(holds_at_finest(on, StopReason::Settled, 0.5, 25, 20));     // the net move is small already
+  EXPECT_FALSE(holds_at_finest(on, StopReason::StepSmall, 0.5, 25, 20));   // past the minimum
   EXPECT_FALSE(holds_at_finest(on, StopReason::MaxIterations, 0.5, 25, 20));
   EXPECT_FALSE(holds_at_finest(on, StopReason::Continue, 0.5, 25, 20));
   const StoppingOptions half{.persistence_wait = 0.5};
@@ -220,6 +220,24 @@ TEST(Stopping, TheFinestResolutionHoldsAConvergedStopWhileTheMovePersists) {
   EXPECT_FALSE(holds_at_finest(StoppingOptions{.persistence_wait = 0.0}, StopReason::Converged, 0.5, 20, 20));
   EXPECT_THROW((StoppingOptions{.persistence_wait = -1.0}).check(), OptionError);
   EXPECT_THROW((StoppingOptions{.persistence_wait = INFINITY}).check(), OptionError);
+}
+
+TEST(Stopping, TheFinestResolutionHoldsASettledStopWhileTheMovePersistsWithItsOwnLimit) {
+  const StoppingOptions on;
+  EXPECT_EQ(on.settled_wait, 3.0);  // the default (the thesis preset's 0: cli_options_test)
+  // A level whose first stop came after 20 iterations: a settled stop waits up to iteration 79.
+  EXPECT_TRUE(holds_at_finest(on, StopReason::Settled, 0.5, 25, 20));
+  EXPECT_TRUE(holds_at_finest(on, StopReason::Settled, 0.5, 79, 20));
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Settled, 0.5, 80, 20));
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Settled, -0.2, 25, 20));  // back and forth
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Settled, NAN, 25, 20));
+  // The Σg stop keeps its own limit (persistence_wait 1: iteration 39).
+  EXPECT_TRUE(holds_at_finest(on, StopReason::Converged, 0.5, 39, 20));
+  EXPECT_FALSE(holds_at_finest(on, StopReason::Converged, 0.5, 40, 20));
+  EXPECT_FALSE(holds_at_finest(StoppingOptions{.settled_wait = 0.0}, StopReason::Settled, 0.5, 25, 20));
+  EXPECT_TRUE(holds_at_finest(StoppingOptions{.persistence_wait = 0.0}, StopReason::Settled, 0.5, 25, 20));
+  EXPECT_THROW((StoppingOptions{.settled_wait = -1.0}).check(), OptionError);
+  EXPECT_THROW((StoppingOptions{.settled_wait = INFINITY}).check(), OptionError);
 }
 
 TEST(Stopping, TheFinestResolutionHoldsAnyRulesStopUntilItsMinimum) {
@@ -259,7 +277,7 @@ TEST(Stopping, TheFinestResolutionWaitCountsFromItsFirstStop) {
   EXPECT_FALSE(wait.wait(options, StopReason::Converged, 0.2, 25, false));
   // A first stop that does not wait (settled, or no budget) still marks the finest resolution.
   FinestResolutionWait settled;
-  EXPECT_FALSE(settled.wait(options, StopReason::Settled, 0.2, 16, true));
+  EXPECT_FALSE(settled.wait(options, StopReason::Settled, -0.2, 16, true));
   EXPECT_TRUE(settled.reached());
   EXPECT_EQ(settled.first_stop(), 16u);
   FinestResolutionWait none;

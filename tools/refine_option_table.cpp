@@ -298,6 +298,11 @@ std::vector<RefineOptionEntry> make_table() {
                     "At the finest resolution a stop by any rule waits until the level has run this many iterations "
                     "(0 = no minimum, the thesis preset; README \"Convergence\")",
                     [](auto& o) -> auto& { return o.stopping.finest_min_iterations; }));
+  t.push_back(value("--settled-wait", "settled_wait", "stopping.settled_wait",
+                    "At the finest resolution a settled stop waits while the surface's net move carries on, for at "
+                    "most this many times the iterations the level ran to its first stop (0 = no wait, the thesis "
+                    "preset; README \"Convergence\")",
+                    [](auto& o) -> auto& { return o.stopping.settled_wait; }));
   t.push_back(value("--average-last", "average_last", "stopping.average_last",
                     "The refined mesh is the mean of the positions of the last this many iterations (of the last "
                     "topology and images), which cancels the vertices' back-and-forth about the minimum of g (1 = the last "

@@ -50,6 +50,7 @@ RefineOptions thesis_preset() {
   options.stopping.settled_noise_reference = 0.0;
   options.stopping.persistence_wait = 0.0;
   options.stopping.finest_min_iterations = 0;
+  options.stopping.settled_wait = 0.0;
   options.stopping.average_last = 1;
   options.damping.enabled = false;
   options.momentum.carry = 0.0;

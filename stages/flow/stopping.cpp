@@ -37,6 +37,7 @@ void StoppingOptions::check() const {
   require_option(settled_tolerance >= 0.0 && std::isfinite(settled_tolerance), "settled_tolerance", settled_tolerance,
                  ">= 0 and finite");
   require_option(finest_min_iterations >= 0, "finest_min_iterations", finest_min_iterations, ">= 0");
+  require_option(settled_wait >= 0.0 && std::isfinite(settled_wait), "settled_wait", settled_wait, ">= 0 and finite");
   require_option(persistence_wait >= 0.0 && std::isfinite(persistence_wait), "persistence_wait", persistence_wait,
                  ">= 0 and finite");
   // Bounded so that max_iterations + run_on (the progress's bound) stays an int.
@@ -58,8 +59,11 @@ bool holds_at_finest(const StoppingOptions& options, StopReason reason, double p
                      std::size_t level_iterations, std::size_t first_stop) {
   const bool rule = reason == StopReason::Converged || reason == StopReason::StepSmall || reason == StopReason::Settled;
   if (rule && level_iterations < static_cast<std::size_t>(options.finest_min_iterations)) return true;
-  return reason == StopReason::Converged && persistence > 0.0 &&  // false for NaN
-         static_cast<double>(level_iterations) < (1.0 + options.persistence_wait) * static_cast<double>(first_stop);
+  double wait = 0.0;
+  if (reason == StopReason::Converged) wait = options.persistence_wait;
+  if (reason == StopReason::Settled) wait = options.settled_wait;
+  return wait > 0.0 && persistence > 0.0 &&  // false for NaN
+         static_cast<double>(level_iterations) < (1.0 + wait) * static_cast<double>(first_stop);
 }
 
 bool FinestResolutionWait::wait(const StoppingOptions& options, StopReason reason, double persistence,

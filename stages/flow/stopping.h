@@ -89,6 +89,13 @@ struct StoppingOptions {
   //! longest unit-sphere run 55 iterations; 20 reached 60, issue 12's limit (README,
   //! "Convergence", session 41).
   int finest_min_iterations = 15;
+  //! At the finest resolution a Settled stop waits while the surface's move persists, as a
+  //! Converged stop does (persistence_wait), for at most settled_wait times the iterations the
+  //! level ran to its first stop: on small rigs the whole surface creeps at a fraction of the
+  //! settled tolerance (l1, l2: median net move 0.0012–0.0020 of an edge at persistence +0.5,
+  //! Σg per vertex falling 10–20 % per five iterations). ≥ 0 (0: no wait, the thesis preset).
+  //! 3: README, "Convergence", session 41.
+  double settled_wait = 3.0;
   //! The run's result is the mean of the positions of its last average_last iterations (one
   //! topology): at a stop many vertices step back and forth about the minimum of g from one
   //! iteration to the next (the error of w1's stop and the next iteration 0.00118 / 0.00114 /
@@ -115,11 +122,11 @@ struct StoppingOptions {
 double settled_tolerance_for_noise(const StoppingOptions& options, double image_noise);
 
 //! Whether a stop at the finest resolution waits: \p reason is a rule's (Converged, StepSmall or
-//! Settled) and the level's \p level_iterations are fewer than finest_min_iterations; or
-//! (StoppingOptions::persistence_wait) \p reason is Converged, \p persistence
-//! (NetNormalMove::last_persistence) is above 0 (false for NaN) and the level's iterations are
-//! fewer than (1 + persistence_wait)·\p first_stop, the level's iterations at its first stop.
-//! Past the minimum, other reasons end the run: Settled already says the net move is small.
+//! Settled) and the level's \p level_iterations are fewer than finest_min_iterations; or \p reason
+//! is Converged (Settled), \p persistence (NetNormalMove::last_persistence) is above 0 (false for
+//! NaN) and the level's iterations are fewer than (1 + persistence_wait)·\p first_stop ((1 +
+//! settled_wait)·\p first_stop), the level's iterations at its first stop. StepSmall past the
+//! minimum ends the run.
 bool holds_at_finest(const StoppingOptions& options, StopReason reason, double persistence,
                      std::size_t level_iterations, std::size_t first_stop);
 
