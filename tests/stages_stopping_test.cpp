@@ -33,6 +33,16 @@ std::pair<std::size_t, StopReason> run(const std::vector<double>& g, double move
   return {0, StopReason::Continue};
 }
 
+// The refiner takes up rule stops only (refinement, the finest resolution's wait, running on): the
+// budget and Continue are not among them.
+TEST(Stopping, TheRulesStopsAreConvergedStepSmallAndSettled) {
+  EXPECT_TRUE(is_rule_stop(StopReason::Converged));
+  EXPECT_TRUE(is_rule_stop(StopReason::StepSmall));
+  EXPECT_TRUE(is_rule_stop(StopReason::Settled));
+  EXPECT_FALSE(is_rule_stop(StopReason::Continue));
+  EXPECT_FALSE(is_rule_stop(StopReason::MaxIterations));
+}
+
 TEST(StoppingOptions, DefaultsFollowTheThesisButForTheTestTheBudgetAndTheMoveRules) {
   const StoppingOptions o;
   EXPECT_NO_THROW(o.check());

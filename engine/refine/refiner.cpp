@@ -238,7 +238,7 @@ class Refinement {
         break;
       }
       const auto iteration_start = Clock::now();
-      untangled_at_stop_ = 0;  // the flow goes on from the last stop's untangled positions: they count
+      stop_untangling_.pairs = 0;  // the flow goes on from the last stop's untangled positions: they count
       IterationReport report;
       report.iteration = iteration;
       double refinement_seconds = 0.0;
@@ -270,7 +270,7 @@ class Refinement {
                                                    data_.net_move_over_edge);
       report.stop = to_string(reason);
       const bool budget_left = stopping.iterations() < static_cast<std::size_t>(options_.stopping.max_iterations);
-      const bool rule_fired = reason != StopReason::Continue && reason != StopReason::MaxIterations;
+      const bool rule_fired = is_rule_stop(reason);
       if (run_on_left_ > 0) {  // StoppingOptions::run_on: every rule off, nothing refined
         report.stop = "running on";
         reason = --run_on_left_ > 0 ? StopReason::Continue : run_on_from_;
@@ -448,13 +448,14 @@ class Refinement {
     // An untangling at a stop the flow went on from lies between the iterates: a mean across it
     // would undo part of it, so the last iterate stands.
     const std::size_t recorded = data_.net_move.recorded();
-    if (untangled_after_iterate_ > 0 && untangled_after_iterate_ < recorded && recorded - untangled_after_iterate_ < count)
+    const std::size_t after = stop_untangling_.after_iterate;
+    if (after > 0 && after < recorded && recorded - after < count)
       return;
     std::vector<Eigen::Vector3d> mean;
     if (!data_.net_move.mean_of_last(count, mean)) return;
     const std::vector<Eigen::Vector3d> last = inside_ ? positions_of(mesh_) : std::vector<Eigen::Vector3d>{};
     set_positions(mesh_, mean);
-    untangled_pairs_ -= untangled_at_stop_;  // the iterates were recorded before the stop's untangling
+    untangled_pairs_ -= stop_untangling_.pairs;  // the iterates were recorded before the stop's untangling
     limit_to_silhouettes(last);  // a mean of two inside positions may leave a concave silhouette
   }
 
@@ -528,8 +529,7 @@ class Refinement {
   // (with either refinement schedule); at full resolution, refine; true when that changed the
   // images or the mesh (the run goes on), recorded in \p report.
   bool refine_at_convergence(StopReason reason, IterationReport& report) {
-    if (reason != StopReason::Converged && reason != StopReason::StepSmall && reason != StopReason::Settled)
-      return false;
+    if (!is_rule_stop(reason)) return false;
     if (!levels_.empty()) {  // settled on these images: the next finer ones before any refinement
       levels_.pop_back();
       views_ = levels_.empty() ? flow_views() : levels_.back()->views;
@@ -563,8 +563,8 @@ class Refinement {
         set_positions(mesh_, flowed);
         untangled_pairs_ = untangled_before;
       } else {
-        untangled_at_stop_ = untangled_pairs_ - untangled_before;
-        if (untangled && untangled->rounds > 0) untangled_after_iterate_ = data_.net_move.recorded();
+        stop_untangling_.pairs = untangled_pairs_ - untangled_before;
+        if (untangled && untangled->rounds > 0) stop_untangling_.after_iterate = data_.net_move.recorded();
       }
       return false;
     }
@@ -638,12 +638,16 @@ class Refinement {
   double reference_edge_ = 0.0;
   double pixel_size_ = 0.0;  //!< world length of one pixel at the object, finest view
   std::size_t untangled_pairs_ = 0;
-  //! Of those, the ones removed at a stop that refined nothing, from positions the run's end may
-  //! replace by the mean of the iterates before it (average_last_iterates); 0 once the flow goes on.
-  std::size_t untangled_at_stop_ = 0;
-  //! The iterates net_move had recorded when a stop that refined nothing untangled the positions
-  //! the flow then went on from (0: none): the final mean does not reach back across it.
-  std::size_t untangled_after_iterate_ = 0;
+  //! The untangling at a stop that refined nothing (refine_at_convergence), which the run's end
+  //! may replace by the mean of the iterates before it (average_last_iterates).
+  struct StopUntangling {
+    //! Of untangled_pairs_, those it removed; 0 once the flow goes on from its positions (then
+    //! they stay counted).
+    std::size_t pairs = 0;
+    //! The iterates net_move had recorded when it untangled positions the flow then went on from
+    //! (0: none): the final mean does not reach back across it.
+    std::size_t after_iterate = 0;
+  } stop_untangling_;
   bool rims_from_masks_ = false;  //!< the silhouettes are the scene's mask images (Scene::masks)
   //! At the run's end the vertices the finest resolution never gave a speed follow too
   //! (UnobservedDisplacementOptions::spread_unmoved).

@@ -9,6 +9,10 @@
 
 namespace mvflow {
 
+bool is_rule_stop(StopReason reason) {
+  return reason == StopReason::Converged || reason == StopReason::StepSmall || reason == StopReason::Settled;
+}
+
 const char* to_string(StopReason reason) {
   switch (reason) {
     case StopReason::Continue:
@@ -57,8 +61,7 @@ double settled_tolerance_for_noise(const StoppingOptions& options, double image_
 
 bool holds_at_finest(const StoppingOptions& options, StopReason reason, double persistence,
                      std::size_t level_iterations, std::size_t first_stop) {
-  const bool rule = reason == StopReason::Converged || reason == StopReason::StepSmall || reason == StopReason::Settled;
-  if (rule && level_iterations < static_cast<std::size_t>(options.finest_min_iterations)) return true;
+  if (is_rule_stop(reason) && level_iterations < static_cast<std::size_t>(options.finest_min_iterations)) return true;
   double wait = 0.0;
   if (reason == StopReason::Converged) wait = options.persistence_wait;
   if (reason == StopReason::Settled) wait = options.settled_wait;

@@ -18,6 +18,10 @@ enum class StopReason {
 //! "continue", "converged", "step-small", "settled" or "max-iterations" (for reports).
 const char* to_string(StopReason reason);
 
+//! Whether \p reason is a stopping rule's (Converged, StepSmall or Settled): the stops a
+//! refinement, the finest resolution's wait or running on may take up; not Continue, not the budget.
+bool is_rule_stop(StopReason reason);
+
 //! How "Σg no longer changes" is tested.
 enum class ConvergenceTest {
   //! Thesis 5.3.3: |100 − 100·G_i/G_{i−l}| < ε for every l = 1..lookback. Never fires while Σg
