@@ -134,8 +134,9 @@ double settled_tolerance_for_noise(const StoppingOptions& options, double image_
 bool holds_at_finest(const StoppingOptions& options, StopReason reason, double persistence,
                      std::size_t level_iterations, std::size_t first_stop);
 
-//! The finest resolution's wait (StoppingOptions::finest_min_iterations, persistence_wait) over
-//! one run: the refiner asks it at every stop once a stop has found nothing left to refine.
+//! The finest resolution's wait (StoppingOptions::finest_min_iterations, persistence_wait,
+//! settled_wait) over one run: the refiner asks it at every stop once a stop has found nothing
+//! left to refine.
 class FinestResolutionWait {
  public:
   //! A stop has found nothing left to refine: the flow is at its finest resolution, where a stop
