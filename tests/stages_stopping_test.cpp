@@ -285,7 +285,8 @@ TEST(Stopping, TheFinestResolutionWaitCountsFromItsFirstStop) {
   EXPECT_FALSE(wait.wait(options, StopReason::Converged, 0.2, 40, true));
   // No budget left: no wait, whatever the persistence.
   EXPECT_FALSE(wait.wait(options, StopReason::Converged, 0.2, 25, false));
-  // A first stop that does not wait (settled, or no budget) still marks the finest resolution.
+  // A first stop that does not wait (settled with a move that does not carry on, or no budget) still
+  // marks the finest resolution.
   FinestResolutionWait settled;
   EXPECT_FALSE(settled.wait(options, StopReason::Settled, -0.2, 16, true));
   EXPECT_TRUE(settled.reached());
