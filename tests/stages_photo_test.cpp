@@ -966,6 +966,71 @@ TEST(SurfacePatch, SamplesAcrossTheLanesGiveTheBitsOfOneEvaluationPerSample) {
   }
 }
 
+TEST(PhotoConsistency, EveryBuildsSamplesAtTheImagesBordersAreOneEvaluationEach) {
+  // The 5×5 kernel locates an axis's patches kLanes samples at a time, and the SSE2 build tests the
+  // range on the truncated pixel coordinates: every build's samples, slot by slot, against one
+  // photo_consistency_5x5 of that build per sample (PhotoView::project and patch_inside), at
+  // points whose samples' patches cross each of an image's four borders, at points behind one
+  // camera, and on images 5 to 8 pixels wide, where at most a few pixels (or none) can hold a patch.
+  std::mt19937 random(41);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const int half = PhotoGradientOptions{}.savitzky_golay.half_window();
+  int partial = 0, compared = 0;
+  const auto check = [&](const std::vector<PhotoView>& views, std::span<const std::uint16_t> ids,
+                         const Eigen::Vector3d& X, double spacing, const std::string& where) {
+    for (const auto& build : detail::photo_kernel_builds()) {
+      std::vector<PhotoValue> samples(static_cast<std::size_t>(6 * half + 1), PhotoValue{-1.0, -1});
+      build.samples(X, spacing, half, ids, views, samples);
+      expect_each_slot_is_one_evaluation(
+          samples, X, spacing, half, [&](const Eigen::Vector3d& point) { return build.consistency(point, ids, views); },
+          false, std::string(" in ") + build.name + where);
+      compared += samples[0].defined();
+      partial += samples[0].defined() &&
+                 std::ranges::any_of(samples, [&](const PhotoValue& p) { return p.views != samples[0].views; });
+    }
+  };
+  for (const int width : {64, 5, 6, 7, 8}) {
+    const int height = width == 64 ? 48 : width;
+    std::vector<Camera> cameras;
+    std::vector<Image> images;
+    for (int i = 0; i < 4; ++i) {
+      const double a = 0.3 * i;
+      cameras.push_back(look_at({3 * std::sin(a), 0.4, 3 * std::cos(a)}, {0, 0, 0}, 60.0 * width / 64, width, height));
+      Image image(width, height);
+      for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+          image.set_pixel(x, y, {static_cast<float>(unit(random)), static_cast<float>(unit(random)),
+                                 static_cast<float>(unit(random))});
+      images.push_back(std::move(image));
+    }
+    const auto views = make_photo_views(cameras, pointers(images));
+    const std::vector<std::uint16_t> ids{0, 1, 2, 3};
+    const std::string size = " (" + std::to_string(width) + "×" + std::to_string(height) + ")";
+    for (int trial = 0; trial < 160 && !HasFailure(); ++trial) {
+      // A pixel 0.5–4.5 pixels inside one of the four borders of one camera, the other coordinate anywhere.
+      const Camera& camera = cameras[static_cast<std::size_t>(trial % 4)];
+      const double inside = 0.5 + 4 * unit(random);
+      const double along_u = unit(random) * width, along_v = unit(random) * height;
+      const int border = (trial / 4) % 4;
+      const double u = border == 0 ? inside : border == 1 ? width - inside : along_u;
+      const double v = border == 2 ? inside : border == 3 ? height - inside : along_v;
+      const Ray ray = camera.ray(u, v);
+      // Spacings that spread the samples over about 1 and 4 pixels of that view.
+      check(views, ids, ray.origin + 3.0 * ray.direction, trial % 2 == 0 ? 0.002 : 0.008, size);
+    }
+    // Behind camera 0, in front of the others: samples of camera 0's lanes have z ≤ 0.
+    for (int trial = 0; trial < 10 && !HasFailure(); ++trial) {
+      const Eigen::Vector3d behind = cameras[0].centre() + 0.02 * (cameras[0].centre() - Eigen::Vector3d::Zero()) +
+                                     0.01 * Eigen::Vector3d(unit(random), unit(random), unit(random));
+      check(views, ids, behind, 0.004, size + " behind camera 0");
+    }
+  }
+  EXPECT_GT(compared, 300);
+  EXPECT_GT(partial, 100);
+  std::printf("[measured] samples at the borders: %d defined centres, %d with samples on other view counts\n",
+              compared, partial);
+}
+
 TEST(SurfacePatch, ReadsTheImagesLastPixelWithoutPassingIt) {
   // A patch whose bottom right point's support holds the image's last pixel (W − 1, H − 1): the
   // kernel reads that pixel's right neighbour from earlier floats (nothing lies after it). Only
