@@ -2,11 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <regex>
+#include <vector>
 
 #include "test_support.h"
+#include "vertex_fields_reader.h"
 
 namespace mvflow {
 namespace {
@@ -106,6 +110,8 @@ TEST(Cli, EveryCommandChecksItsOutputsBeforeAnyWork) {
        "cannot be created as the output folder", "[1/"},
       {"synth --level 1 --views 2 --width 16 --height 12 -o " + (blocker / "scene").string(),
        "cannot be created as the output folder", "rendered"},
+      {"refine " + scene + " -o " + (folder / "r.ply").string() + " --dump-fields " + (blocker / "fields").string(),
+       "cannot be created as the output folder", "refining"},
       {"eval " + mesh + " " + mesh + " --json " + (blocker / "e.json").string(), "does not exist", "accuracy"},
       {"heldout " + scene + " " + mesh + " --views 0 --json " + (blocker / "h.json").string(), "does not exist",
        "scoring"},
@@ -120,6 +126,41 @@ TEST(Cli, EveryCommandChecksItsOutputsBeforeAnyWork) {
     EXPECT_EQ(r.output.find(c.work_started), std::string::npos) << "the work started: " << r.output;
   }
   EXPECT_FALSE(fs::exists(folder / "h.ply"));
+  EXPECT_FALSE(fs::exists(folder / "r.ply"));
+}
+
+TEST(Cli, RefineDumpsEachIterationsVertexFields) {
+  test::ScratchFolder folder;
+  const fs::path scene = folder / "scene", dumps = folder / "fields" / "run";  // created, parents too
+  const std::string synth = "synth --views 8 --width 160 --height 120 --level 3 --init-vertices 200 -o ";
+  ASSERT_EQ(run(synth + scene.string()).exit_code, 0);
+  const CommandResult r = run("refine " + scene.string() + " -o " + (folder / "r.ply").string() + " --report " +
+                              (folder / "r.json").string() + " --max-iterations 6 --min-iterations 6 --dump-fields " +
+                              dumps.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string report = test::read_text(folder / "r.json");
+  // One file per iteration the report lists, named by iteration, and nothing else.
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dumps)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  std::vector<std::string> expected;
+  for (int k = 1; k <= 6; ++k) expected.push_back("iteration_000" + std::to_string(k) + ".ply");
+  EXPECT_EQ(names, expected);
+  // The last one's vertices with g are those the report counts (its "defined_g", read from the
+  // JSON text), and its surface has the report's vertex count.
+  const test::VertexFieldsDump last = test::read_vertex_fields_dump(dumps / "iteration_0006.ply");
+  EXPECT_EQ(last.comments.at("iteration"), "6");
+  std::size_t with_g = 0;
+  for (std::size_t v = 0; v < last.rows.size(); ++v) with_g += !std::isnan(last.value(v, "g"));
+  const std::size_t iteration6 = report.find("\"iteration\": 6");
+  ASSERT_NE(iteration6, std::string::npos);
+  const auto number_after = [&](const std::string& key) {
+    const std::size_t at = report.find("\"" + key + "\": ", report.rfind('{', iteration6));
+    return std::stoul(report.substr(at + key.size() + 4));
+  };
+  EXPECT_EQ(with_g, number_after("defined_g"));
+  EXPECT_EQ(last.rows.size(), number_after("vertices"));
+  EXPECT_GT(with_g, 0u);
 }
 
 TEST(Cli, NonManifoldMeshIsReportedNotFatal) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "cancel_probe.h"
 #include "engine/model/error.h"
@@ -247,6 +249,83 @@ TEST(Refiner, FarVerticesReadOtherPhotographsFromTheIterationAfterTheyAreFlagged
 
 TEST(Refiner, SameBitsForThreadsBlockSizesAndEngines) {
   for (const RefineOptions& options : determinism_cases()) expect_same_bits(options);
+}
+
+// One iteration's per-vertex state as RefineControl::on_vertex_fields hands it over: what the
+// test keeps of each call.
+struct VertexFieldsCall {
+  int iteration = 0;
+  double time_step = 0.0;
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<double> g, speed_normal, moved, damping;
+  std::size_t defined_g = 0, moving = 0, moved_without_speed = 0;
+};
+
+std::vector<VertexFieldsCall> refine_watching_vertex_fields(const RefineOptions& options, int threads,
+                                                            RefineResult* result) {
+  std::vector<VertexFieldsCall> calls;
+  RefineControl control;
+  control.threads = threads;
+  control.on_vertex_fields = [&](const IterationVertexFields& state) {
+    VertexFieldsCall call{.iteration = state.iteration, .time_step = state.time_step};
+    const VertexFields& f = *state.fields;
+    for (std::size_t v = 0; v < state.mesh->n_vertices(); ++v) {
+      call.positions.push_back(to_eigen(state.mesh->point(TriMesh::VertexHandle(static_cast<int>(v)))));
+      call.g.push_back(f.photo_consistency[v]);
+      call.speed_normal.push_back(f.speed[v].dot(f.normal[v]));
+      call.defined_g += (f.defined[v] & kPhotoDefined) != 0;
+      call.moving += (f.defined[v] & kSpeedDefined) != 0;
+      call.moved_without_speed += !(f.defined[v] & kSpeedDefined) && state.moved[v] != 0.0;
+    }
+    call.moved.assign(state.moved.begin(), state.moved.end());
+    call.damping.assign(state.damping_scale.begin(), state.damping_scale.end());
+    calls.push_back(std::move(call));
+  };
+  *result = refine_mesh(small_scene().scene, small_scene().initial, options, control);
+  return calls;
+}
+
+TEST(Refiner, HandsEachIterationsVertexFieldsToTheCaller) {
+  // No split/collapse, refinement, untangling or averaging: the result is the last iterate, in the
+  // initial mesh's vertex order.
+  RefineOptions options = few_iterations(8);
+  options.global_remeshing = false;
+  options.adaptive_refinement = false;
+  options.untangling.max_rounds = 0;
+  options.stopping.average_last = 1;
+  RefineResult result;
+  const std::vector<VertexFieldsCall> calls = refine_watching_vertex_fields(options, 2, &result);
+  ASSERT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+  const auto& reports = result.summary.iterations;
+  ASSERT_EQ(calls.size(), reports.size());
+  for (std::size_t k = 0; k < calls.size(); ++k) {
+    // Each call is its iteration's: the report counts the same vertices with g and with a speed.
+    EXPECT_EQ(calls[k].iteration, reports[k].iteration);
+    EXPECT_EQ(calls[k].time_step, reports[k].time_step);
+    EXPECT_EQ(calls[k].defined_g, reports[k].defined_g) << k;
+    EXPECT_EQ(calls[k].moving, reports[k].moving) << k;
+    EXPECT_EQ(calls[k].moved_without_speed, 0u) << k;
+    ASSERT_EQ(calls[k].positions.size(), result.mesh.n_vertices());
+    EXPECT_EQ(calls[k].moved.size(), calls[k].positions.size());
+    EXPECT_EQ(calls[k].damping.size(), calls[k].positions.size());  // damping is on by default
+  }
+  for (std::size_t v = 0; v < result.mesh.n_vertices(); ++v)
+    ASSERT_EQ(calls.back().positions[v], result.mesh.position(v)) << "vertex " << v;
+  // The vertices did move in the last iteration.
+  const VertexFieldsCall& last = calls.back();
+  EXPECT_GT(*std::max_element(last.moved.begin(), last.moved.end()), 0.0);
+
+  // The same bits with one thread as with two.
+  RefineResult single;
+  const std::vector<VertexFieldsCall> one = refine_watching_vertex_fields(options, 1, &single);
+  ASSERT_EQ(one.size(), calls.size());
+  for (std::size_t k = 0; k < calls.size(); ++k) {
+    EXPECT_EQ(one[k].positions, calls[k].positions) << k;
+    EXPECT_EQ(one[k].g, calls[k].g) << k;
+    EXPECT_EQ(one[k].speed_normal, calls[k].speed_normal) << k;
+    EXPECT_EQ(one[k].moved, calls[k].moved) << k;
+    EXPECT_EQ(one[k].damping, calls[k].damping) << k;
+  }
 }
 
 TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {

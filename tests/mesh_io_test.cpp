@@ -18,6 +18,9 @@
 #include <sstream>
 
 #include "engine/model/error.h"
+#include "io/vertex_fields_io.h"
+#include "stages_meshes.h"
+#include "vertex_fields_reader.h"
 
 namespace mvflow::io {
 namespace {
@@ -685,6 +688,81 @@ TEST_F(MeshIoTest, FailedWriteLeavesTheDestinationUntouched) {
   for (const auto& entry : fs::directory_iterator(dir_)) left.push_back(entry.path().filename().string());
   std::sort(left.begin(), left.end());
   EXPECT_EQ(left, (std::vector<std::string>{"m.obj", "m.off", "m.ply", "m.stl", "m.wrl"}));
+}
+
+TEST_F(MeshIoTest, VertexFieldsDumpHoldsEveryVertexsStateAndTheFaces) {
+  // A level-1 icosphere (42 vertices) with values that tell the columns apart: vertex v's g is
+  // 0.5·v + 1 where defined, its H −v, ∇g = (v, 2v, 3v), F = 10·v·N, scale 1/(v + 1), move 0.01·v.
+  const TriMesh mesh = test::icosphere(1.0, 1);
+  const std::size_t n = mesh.n_vertices();
+  VertexFields fields;
+  fields.resize(n, 4);
+  std::vector<double> scale(n), moved(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const double x = static_cast<double>(v);
+    fields.normal[v] = Eigen::Vector3d(x, 1.0, -2.0).normalized();
+    fields.mean_curvature[v] = -x;
+    fields.photo_consistency[v] = 0.5 * x + 1.0;
+    fields.photo_gradient[v] = Eigen::Vector3d(x, 2 * x, 3 * x);
+    fields.speed[v] = 10.0 * x * fields.normal[v];
+    // Every third vertex has no g (nor gradient, nor speed); every fifth g but no gradient.
+    fields.defined[v] = v % 3 == 0 ? kNormalDefined
+                                   : (v % 5 == 0 ? kNormalDefined | kPhotoDefined | kSpeedDefined
+                                                 : kNormalDefined | kPhotoDefined | kGradientDefined | kSpeedDefined);
+    fields.visible_count[v] = static_cast<std::uint16_t>(v % 4);
+    fields.patch_kind[v] = static_cast<PatchKind>(v % 3);
+    scale[v] = 1.0 / (x + 1.0);
+    moved[v] = 0.01 * x;
+  }
+  IterationVertexFields state{.iteration = 7, .time_step = 0.0625, .mesh = &mesh, .fields = &fields,
+                              .damping_scale = scale, .moved = moved};
+  const fs::path file = path(vertex_fields_file_name(7));
+  EXPECT_EQ(file.filename(), "iteration_0007.ply");
+  write_vertex_fields(file, state);
+
+  const test::VertexFieldsDump dump = test::read_vertex_fields_dump(file);
+  EXPECT_EQ(dump.comments.at("iteration"), "7");
+  EXPECT_EQ(std::stod(dump.comments.at("time_step")), 0.0625);
+  ASSERT_EQ(dump.rows.size(), n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const double x = static_cast<double>(v);
+    const auto p = mesh.point(TriMesh::VertexHandle(static_cast<int>(v)));
+    const Eigen::Vector3d normal = Eigen::Vector3d(x, 1.0, -2.0).normalized();
+    EXPECT_EQ(dump.value(v, "x"), p[0]);
+    EXPECT_EQ(dump.value(v, "z"), p[2]);
+    EXPECT_EQ(dump.value(v, "ny"), normal.y());
+    EXPECT_EQ(dump.value(v, "mean_curvature"), -x);
+    EXPECT_EQ(dump.value(v, "damping"), 1.0 / (x + 1.0));
+    EXPECT_EQ(dump.value(v, "moved"), 0.01 * x);
+    const bool has_g = v % 3 != 0, has_gradient = has_g && v % 5 != 0;
+    if (has_g) {
+      EXPECT_EQ(dump.value(v, "g"), 0.5 * x + 1.0) << v;
+      EXPECT_NEAR(dump.value(v, "speed_normal"), 10.0 * x, 1e-12 * (1 + x)) << v;
+    } else {
+      EXPECT_TRUE(std::isnan(dump.value(v, "g"))) << v;
+      EXPECT_EQ(dump.value(v, "speed_normal"), 0.0) << v;
+    }
+    if (has_gradient)
+      EXPECT_NEAR(dump.value(v, "grad_g_normal"), Eigen::Vector3d(x, 2 * x, 3 * x).dot(normal), 1e-12 * (1 + x)) << v;
+    else
+      EXPECT_TRUE(std::isnan(dump.value(v, "grad_g_normal"))) << v;
+    EXPECT_EQ(dump.byte(v, "defined"), fields.defined[v]);
+    EXPECT_EQ(dump.byte(v, "views"), v % 4);
+    EXPECT_EQ(dump.byte(v, "patch"), v % 3);
+  }
+  const auto triangles = triangles_of(mesh);
+  ASSERT_EQ(dump.faces.size(), triangles.size());
+  for (std::size_t f = 0; f < triangles.size(); ++f)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(static_cast<std::uint32_t>(dump.faces[f][c]), triangles[f][c]);
+
+  // Without damping the scale reads 1; arrays sized for another mesh are refused, nothing written.
+  state.damping_scale = {};
+  write_vertex_fields(file, state);
+  EXPECT_EQ(test::read_vertex_fields_dump(file).value(5, "damping"), 1.0);
+  const std::vector<double> short_moves(n - 1, 0.0);
+  state.moved = short_moves;
+  EXPECT_THROW(write_vertex_fields(path("other.ply"), state), Error);
+  EXPECT_FALSE(fs::exists(path("other.ply")));
 }
 
 }  // namespace

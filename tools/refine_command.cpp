@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -12,6 +13,7 @@
 #include "io/mesh_io.h"
 #include "io/report_io.h"
 #include "io/scene_io.h"
+#include "io/vertex_fields_io.h"
 #include "stages/flow/photo_kernel.h"
 #include "tools/commands.h"
 #include "tools/interrupt.h"
@@ -27,6 +29,7 @@ struct RefineArguments {
   std::string output;
   std::string report;
   std::string masks;
+  std::string dump_fields;
   std::string preset = "default";
   bool ascii = false;
   int threads = 0;
@@ -37,6 +40,7 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
   // Before the scene is read: a refinement that cannot write its result is not started.
   io::check_writable(args.output);
   if (!args.report.empty()) io::check_writable(args.report);
+  if (!args.dump_fields.empty()) io::prepare_output_folder(args.dump_fields);
   const Scene scene = io::load_scene(args.scene, {.mask_folder = args.masks});
   std::string mesh_file = args.mesh;
   if (mesh_file.empty() && scene.mesh_file) mesh_file = scene.mesh_file->string();
@@ -59,6 +63,10 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
       std::fprintf(stderr, "\r\033[K%s: iteration %d/%d, %zu vertices, Σg/vertex %.5g", to_string(p.stage), p.iteration,
                    p.max_iterations, p.vertices, p.sum_g_per_vertex);
   };
+  if (!args.dump_fields.empty())
+    control.on_vertex_fields = [folder = std::filesystem::path(args.dump_fields)](const IterationVertexFields& state) {
+      io::write_vertex_fields(folder / io::vertex_fields_file_name(state.iteration), state);
+    };
   log.info("refining {} ({} vertices) with {} views of {}", mesh_file, initial.n_vertices(), scene.size(),
            scene.folder.string());
   const RefineResult result = refine_mesh(scene, initial, options, control);
@@ -98,6 +106,10 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("-o,--output", args->output, "Refined mesh (PLY with colour and quality = g; format by extension)")
       ->required();
   c->add_option("--report", args->report, "JSON report (per iteration and per stage)");
+  c->add_option("--dump-fields", args->dump_fields,
+                "Folder (created if missing) for one PLY per iteration, iteration_NNNN.ply: the surface after the "
+                "iteration with each vertex's normal, g, H, grad g along N, speed along N, damping scale, move, "
+                "defined bits, views and patch kind (README \"Formats\"); about 100 bytes per vertex and iteration");
   c->add_option("--masks", args->masks,
                 "Folder of silhouette masks, one per view named after its photograph (object: any channel > 0): the "
                 "rims are fitted to them (with --fit-silhouettes auto or on) and anchor the unobserved spread, and "

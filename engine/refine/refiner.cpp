@@ -265,6 +265,7 @@ class Refinement {
         break;
       }
       fill_report(report, edges, refinement_seconds, iteration_start);
+      if (control_.on_vertex_fields) report_vertex_fields(iteration);
       count_observed();
       StopReason reason = stopping.add_iteration(data_.total.sum_g, data_.median_move, data_.total.defined_g,
                                                    data_.net_move_over_edge);
@@ -598,6 +599,17 @@ class Refinement {
       for (std::size_t s = 0; s < kStageCount; ++s) report.stage_seconds[s] += slots[s];
     report.stage_seconds[static_cast<int>(Stage::Refinement)] = refinement_seconds;
     report.seconds = seconds_since(iteration_start);
+  }
+
+  void report_vertex_fields(int iteration) const {
+    IterationVertexFields state;
+    state.iteration = iteration;
+    state.time_step = data_.time_step;
+    state.mesh = &mesh_;
+    state.fields = &data_.fields;
+    if (options_.damping.enabled) state.damping_scale = data_.damping.scale;
+    state.moved = data_.moved;
+    control_.on_vertex_fields(state);
   }
 
   void announce(const IterationReport& report) {

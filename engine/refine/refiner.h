@@ -9,10 +9,11 @@
 
 #include <spdlog/logger.h>
 
+#include "engine/model/iteration_vertex_fields.h"
 #include "engine/model/mesh.h"
-#include "engine/refine/refine_options.h"
 #include "engine/model/refine_report.h"
 #include "engine/model/scene.h"
+#include "engine/refine/refine_options.h"
 
 namespace mvflow {
 
@@ -39,6 +40,9 @@ struct RefineControl {
   //! the engine's threads, several at once: keep it short and thread-safe.
   std::function<void(std::size_t block)> on_block;
   std::function<void(const RefineProgress&)> on_progress;
+  //! After each iteration, before its IterationReport's callbacks, on the calling thread: every
+  //! vertex's state (IterationVertexFields). Costs nothing when empty; `refine --dump-fields`.
+  std::function<void(const IterationVertexFields&)> on_vertex_fields;
 };
 
 struct RefineResult {
