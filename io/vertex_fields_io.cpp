@@ -7,6 +7,7 @@
 #include "engine/model/error.h"
 #include "io/atomic_write.h"
 #include "io/little_endian.h"
+#include "io/number_text.h"
 
 namespace mvflow::io {
 
@@ -26,15 +27,14 @@ void write_vertex_fields(const std::filesystem::path& file, const IterationVerte
                "write_vertex_fields: the fields are not sized for the mesh");
   MVFLOW_CHECK(state.damping_scale.empty() || state.damping_scale.size() == n,
                "write_vertex_fields: the damping scales are not sized for the mesh");
+  MVFLOW_CHECK(state.moving_speed.size() == n, "write_vertex_fields: the moving speeds are not sized for the mesh");
   MVFLOW_CHECK(state.moved.empty() || state.moved.size() == n,
                "write_vertex_fields: the moves are not sized for the mesh");
 
-  char time_step[64];
-  std::snprintf(time_step, sizeof time_step, "%.17g", state.time_step);
   std::string bytes =
-      "ply\nformat binary_little_endian 1.0\ncomment written by mvflow refine --dump-fields\ncomment "
+      "ply\nformat binary_little_endian 1.0\ncomment mvflow per-vertex fields\ncomment "
       "iteration " +
-      std::to_string(state.iteration) + "\ncomment time_step " + time_step + "\nelement vertex " +
+      std::to_string(state.iteration) + "\ncomment time_step " + format_number(state.time_step) + "\nelement vertex " +
       std::to_string(n) + "\n";
   for (const char* name : {"x", "y", "z", "nx", "ny", "nz", "g", "mean_curvature", "grad_g_normal",
                            "speed_normal", "damping", "moved"})
@@ -56,9 +56,9 @@ void write_vertex_fields(const std::filesystem::path& file, const IterationVerte
         normal.y(),
         normal.z(),
         (defined & kPhotoDefined) ? fields.photo_consistency[v] : nan,
-        fields.mean_curvature[v],
+        (defined & kCurvatureDefined) ? fields.mean_curvature[v] : nan,
         (defined & kGradientDefined) ? fields.photo_gradient[v].dot(normal) : nan,
-        (defined & kSpeedDefined) ? fields.speed[v].dot(normal) : 0.0,
+        state.moving_speed[v],
         state.damping_scale.empty() ? 1.0 : state.damping_scale[v],
         state.moved.empty() ? 0.0 : state.moved[v],
     };

@@ -12,17 +12,17 @@
 
 namespace mvflow::io {
 
-//! The file name of iteration \p iteration's dump in a --dump-fields folder:
-//! "iteration_0007.ply" (four digits or more, so that the names sort in iteration order).
+//! The file name of iteration \p iteration's dump in a --dump-fields folder: "iteration_0007.ply"
+//! (zero-padded to four digits, so that the names of a run of up to 9999 iterations sort in order).
 std::string vertex_fields_file_name(int iteration);
 
 //! Writes \p state to \p file atomically (write_atomically): element vertex with double x, y, z,
-//! nx, ny, nz, g, mean_curvature, grad_g_normal (∇g·N), speed_normal (F·N), damping (the step
-//! damping's scale, 1 with damping off), moved (the flow step's length), uchar defined
-//! (VertexDefined bits), views (visible views, at most 255 counted), patch (PatchKind: 0
-//! undecided, 1 image, 2 surface); then element face with the triangles. g is NaN where it is not
-//! defined (kPhotoDefined), grad_g_normal where the gradient is not (kGradientDefined), speed_normal
-//! 0 where there is no speed. Comments give the iteration and Δt.
+//! nx, ny, nz, g, mean_curvature, grad_g_normal (∇g·N), speed_normal (the state's moving_speed),
+//! damping (the step damping's scale, 1 with damping off), moved (the flow step's length), uchar
+//! defined (VertexDefined bits), views (visible views, at most 255 counted), patch (PatchKind: 0
+//! undecided, 1 image, 2 surface); then element face with the triangles. g, H and ∇g·N are NaN
+//! where not defined (kPhotoDefined, kCurvatureDefined, kGradientDefined). Comments give the
+//! iteration and Δt.
 //! \throw Error if the state's arrays are not sized for its mesh; IoError if the file cannot be written.
 void write_vertex_fields(const std::filesystem::path& file, const IterationVertexFields& state);
 

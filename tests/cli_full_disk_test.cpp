@@ -1,6 +1,7 @@
 // A full disk while `mvflow` writes: on a 64 KiB tmpfs filled up to its last kilobyte, every kind
 // of output (mesh, JSON report, PNG) fails with a clear error, exit 1, and leaves the previous
-// file of that name untouched and no temporary file behind. Needs root (mount); skipped otherwise.
+// file of that name untouched and no temporary file behind; the per-vertex dumps stop with a
+// warning instead. Needs root (mount); skipped otherwise.
 
 #include <gtest/gtest.h>
 
@@ -79,6 +80,22 @@ TEST_F(FullDisk, ReportAndImageOutputsFailAndKeepTheOldFile) {
   const auto render = test::run_mvflow("render " + kScene.string() + " " + (kScene / "init.off").string() +
                                        " --view 0 -o " + png.string());
   expect_failed_and_intact(render, png);
+}
+
+TEST_F(FullDisk, PerVertexDumpsStopWithAWarningAndTheRunGoesOn) {
+  // The dumps are a diagnostic: on a full disk they stop, the refined mesh is still written.
+  const fs::path scene = scratch_ / "scene", dumps = disk_ / "dumps";
+  ASSERT_EQ(test::run_mvflow("synth --views 8 --width 160 --height 120 --level 3 --init-vertices 200 -o " +
+                             scene.string())
+                .exit_code,
+            0);
+  const auto r = test::run_mvflow("refine " + scene.string() + " -o " + (scratch_ / "refined.ply").string() +
+                                  " --max-iterations 6 --min-iterations 6 --dump-fields " + dumps.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("iteration_0001.ply"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no more per-vertex dumps after iteration 0"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(scratch_ / "refined.ply"));
+  EXPECT_TRUE(fs::is_empty(dumps)) << "a dump or a temporary file was left behind";
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <regex>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "test_support.h"
 #include "vertex_fields_reader.h"
 
@@ -152,15 +154,19 @@ TEST(Cli, RefineDumpsEachIterationsVertexFields) {
   EXPECT_EQ(last.comments.at("iteration"), "6");
   std::size_t with_g = 0;
   for (std::size_t v = 0; v < last.rows.size(); ++v) with_g += !std::isnan(last.value(v, "g"));
-  const std::size_t iteration6 = report.find("\"iteration\": 6");
-  ASSERT_NE(iteration6, std::string::npos);
-  const auto number_after = [&](const std::string& key) {
-    const std::size_t at = report.find("\"" + key + "\": ", report.rfind('{', iteration6));
-    return std::stoul(report.substr(at + key.size() + 4));
-  };
-  EXPECT_EQ(with_g, number_after("defined_g"));
-  EXPECT_EQ(last.rows.size(), number_after("vertices"));
+  const nlohmann::json iteration6 = nlohmann::json::parse(report).at("iterations").at(5);
+  EXPECT_EQ(iteration6.at("iteration"), 6);
+  EXPECT_EQ(with_g, iteration6.at("defined_g").get<std::size_t>());
+  EXPECT_EQ(last.rows.size(), iteration6.at("vertices").get<std::size_t>());
   EXPECT_GT(with_g, 0u);
+
+  // A folder that holds another run's dumps is refused before any work.
+  const CommandResult again = run("refine " + scene.string() + " -o " + (folder / "r2.ply").string() +
+                                  " --max-iterations 6 --min-iterations 6 --dump-fields " + dumps.string());
+  EXPECT_EQ(again.exit_code, 1) << again.output;
+  EXPECT_NE(again.output.find("holds per-vertex dumps of another run"), std::string::npos) << again.output;
+  EXPECT_EQ(again.output.find("refining"), std::string::npos) << again.output;
+  EXPECT_FALSE(fs::exists(folder / "r2.ply"));
 }
 
 TEST(Cli, NonManifoldMeshIsReportedNotFatal) {

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <bit>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
@@ -257,32 +258,42 @@ struct VertexFieldsCall {
   int iteration = 0;
   double time_step = 0.0;
   std::vector<Eigen::Vector3d> positions;
-  std::vector<double> g, speed_normal, moved, damping;
+  std::vector<double> g, moving_speed, moved, damping;
   std::size_t defined_g = 0, moving = 0, moved_without_speed = 0;
 };
 
-std::vector<VertexFieldsCall> refine_watching_vertex_fields(const RefineOptions& options, int threads,
-                                                            RefineResult* result) {
+// A run of the small scene with its calls; it must not fail, and it calls once per iteration.
+struct WatchedRun {
+  RefineResult result;
   std::vector<VertexFieldsCall> calls;
+};
+
+WatchedRun refine_watching_vertex_fields(const RefineOptions& options, int threads) {
+  WatchedRun run;
+  std::vector<VertexFieldsCall>& calls = run.calls;
   RefineControl control;
   control.threads = threads;
   control.on_vertex_fields = [&](const IterationVertexFields& state) {
-    VertexFieldsCall call{.iteration = state.iteration, .time_step = state.time_step};
+    VertexFieldsCall call;
+    call.iteration = state.iteration;
+    call.time_step = state.time_step;
     const VertexFields& f = *state.fields;
     for (std::size_t v = 0; v < state.mesh->n_vertices(); ++v) {
       call.positions.push_back(to_eigen(state.mesh->point(TriMesh::VertexHandle(static_cast<int>(v)))));
       call.g.push_back(f.photo_consistency[v]);
-      call.speed_normal.push_back(f.speed[v].dot(f.normal[v]));
       call.defined_g += (f.defined[v] & kPhotoDefined) != 0;
       call.moving += (f.defined[v] & kSpeedDefined) != 0;
-      call.moved_without_speed += !(f.defined[v] & kSpeedDefined) && state.moved[v] != 0.0;
+      call.moved_without_speed += !(f.defined[v] & (kSpeedDefined | kSpeedFilled)) && state.moved[v] != 0.0;
     }
+    call.moving_speed.assign(state.moving_speed.begin(), state.moving_speed.end());
     call.moved.assign(state.moved.begin(), state.moved.end());
     call.damping.assign(state.damping_scale.begin(), state.damping_scale.end());
     calls.push_back(std::move(call));
   };
-  *result = refine_mesh(small_scene().scene, small_scene().initial, options, control);
-  return calls;
+  run.result = refine_mesh(small_scene().scene, small_scene().initial, options, control);
+  EXPECT_NE(run.result.summary.status, RefineStatus::Failed) << run.result.summary.message;
+  EXPECT_EQ(run.calls.size(), run.result.summary.iterations.size());
+  return run;
 }
 
 TEST(Refiner, HandsEachIterationsVertexFieldsToTheCaller) {
@@ -293,39 +304,76 @@ TEST(Refiner, HandsEachIterationsVertexFieldsToTheCaller) {
   options.adaptive_refinement = false;
   options.untangling.max_rounds = 0;
   options.stopping.average_last = 1;
-  RefineResult result;
-  const std::vector<VertexFieldsCall> calls = refine_watching_vertex_fields(options, 2, &result);
-  ASSERT_NE(result.summary.status, RefineStatus::Failed) << result.summary.message;
+  const WatchedRun run = refine_watching_vertex_fields(options, 2);
+  ASSERT_FALSE(HasFailure());
+  const auto& [result, calls] = run;
   const auto& reports = result.summary.iterations;
-  ASSERT_EQ(calls.size(), reports.size());
+  std::size_t damped_steps = 0;
   for (std::size_t k = 0; k < calls.size(); ++k) {
     // Each call is its iteration's: the report counts the same vertices with g and with a speed.
-    EXPECT_EQ(calls[k].iteration, reports[k].iteration);
-    EXPECT_EQ(calls[k].time_step, reports[k].time_step);
+    EXPECT_EQ(calls[k].iteration, static_cast<int>(k) + 1);
     EXPECT_EQ(calls[k].defined_g, reports[k].defined_g) << k;
     EXPECT_EQ(calls[k].moving, reports[k].moving) << k;
     EXPECT_EQ(calls[k].moved_without_speed, 0u) << k;
     ASSERT_EQ(calls[k].positions.size(), result.mesh.n_vertices());
+    ASSERT_EQ(calls[k].moving_speed.size(), calls[k].positions.size());
     EXPECT_EQ(calls[k].moved.size(), calls[k].positions.size());
     EXPECT_EQ(calls[k].damping.size(), calls[k].positions.size());  // damping is on by default
+    // The speed recorded is the one the vertices moved by: a step within the CFL bound is Δt·|F·N|
+    // to the last bits (F is along N but at the few vertices of implausible g), also at the
+    // vertices the damping slowed, whose speeds before it were 2–8 times longer.
+    std::size_t moving = 0, matching = 0, damped = 0, damped_matching = 0;
+    for (std::size_t v = 0; v < calls[k].moved.size(); ++v) {
+      if (calls[k].moved[v] == 0.0) continue;
+      const bool match = std::abs(calls[k].moved[v] - calls[k].time_step * std::abs(calls[k].moving_speed[v])) <=
+                         1e-12 * calls[k].moved[v];
+      ++moving, matching += match;
+      if (calls[k].damping[v] < 1.0) ++damped, damped_matching += match;
+    }
+    EXPECT_GT(moving, 0u) << k;
+    EXPECT_GT(matching, moving / 2) << k << ": " << matching << " of " << moving << " steps are Δt·|F·N|";
+    EXPECT_TRUE(damped == 0 || 2 * damped_matching > damped)
+        << k << ": " << damped_matching << " of " << damped << " damped steps are Δt·|F·N|";
+    damped_steps += damped;
   }
+  EXPECT_GT(damped_steps, 0u) << "the case must exercise the damping";
   for (std::size_t v = 0; v < result.mesh.n_vertices(); ++v)
     ASSERT_EQ(calls.back().positions[v], result.mesh.position(v)) << "vertex " << v;
-  // The vertices did move in the last iteration.
-  const VertexFieldsCall& last = calls.back();
-  EXPECT_GT(*std::max_element(last.moved.begin(), last.moved.end()), 0.0);
 
   // The same bits with one thread as with two.
-  RefineResult single;
-  const std::vector<VertexFieldsCall> one = refine_watching_vertex_fields(options, 1, &single);
+  const WatchedRun single = refine_watching_vertex_fields(options, 1);
+  const std::vector<VertexFieldsCall>& one = single.calls;
   ASSERT_EQ(one.size(), calls.size());
   for (std::size_t k = 0; k < calls.size(); ++k) {
     EXPECT_EQ(one[k].positions, calls[k].positions) << k;
     EXPECT_EQ(one[k].g, calls[k].g) << k;
-    EXPECT_EQ(one[k].speed_normal, calls[k].speed_normal) << k;
+    EXPECT_EQ(one[k].moving_speed, calls[k].moving_speed) << k;
     EXPECT_EQ(one[k].moved, calls[k].moved) << k;
     EXPECT_EQ(one[k].damping, calls[k].damping) << k;
   }
+}
+
+TEST(Refiner, VertexFieldsFollowTheRefinementsAndTheSequentialEngine) {
+  // Coarse to fine: a call comes before its iteration's refinement, so it has the vertices the
+  // report counts for that iteration, and the next call those of the refined mesh.
+  RefineOptions options = converging_early(24);
+  options.engine = EngineKind::Sequential;
+  const WatchedRun run = refine_watching_vertex_fields(options, 2);
+  ASSERT_FALSE(HasFailure());
+  const auto& reports = run.result.summary.iterations;
+  const auto& calls = run.calls;
+  std::size_t refinements = 0;
+  for (std::size_t k = 0; k < calls.size(); ++k) {
+    EXPECT_EQ(calls[k].positions.size(), reports[k].vertices) << k;
+    EXPECT_EQ(calls[k].moving_speed.size(), reports[k].vertices) << k;
+    EXPECT_EQ(calls[k].damping.size(), reports[k].vertices) << k;
+    EXPECT_EQ(calls[k].defined_g, reports[k].defined_g) << k;
+    if (reports[k].stop.starts_with("refined") && k + 1 < calls.size()) {
+      ++refinements;
+      EXPECT_GT(calls[k + 1].positions.size(), calls[k].positions.size()) << k;
+    }
+  }
+  EXPECT_GT(refinements, 0u) << "the case must refine within the run";
 }
 
 TEST(Refiner, MovesTheInitialMeshTowardTheTruth) {

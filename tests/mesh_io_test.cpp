@@ -692,30 +692,33 @@ TEST_F(MeshIoTest, FailedWriteLeavesTheDestinationUntouched) {
 
 TEST_F(MeshIoTest, VertexFieldsDumpHoldsEveryVertexsStateAndTheFaces) {
   // A level-1 icosphere (42 vertices) with values that tell the columns apart: vertex v's g is
-  // 0.5·v + 1 where defined, its H −v, ∇g = (v, 2v, 3v), F = 10·v·N, scale 1/(v + 1), move 0.01·v.
+  // 0.5·v + 1 where defined, its H −v, ∇g = (v, 2v, 3v), F·N as it moved 7·v, scale 1/(v + 1),
+  // move 0.01·v.
   const TriMesh mesh = test::icosphere(1.0, 1);
   const std::size_t n = mesh.n_vertices();
   VertexFields fields;
   fields.resize(n, 4);
-  std::vector<double> scale(n), moved(n);
+  std::vector<double> scale(n), moved(n), moving_speed(n);
   for (std::size_t v = 0; v < n; ++v) {
     const double x = static_cast<double>(v);
     fields.normal[v] = Eigen::Vector3d(x, 1.0, -2.0).normalized();
     fields.mean_curvature[v] = -x;
     fields.photo_consistency[v] = 0.5 * x + 1.0;
     fields.photo_gradient[v] = Eigen::Vector3d(x, 2 * x, 3 * x);
-    fields.speed[v] = 10.0 * x * fields.normal[v];
-    // Every third vertex has no g (nor gradient, nor speed); every fifth g but no gradient.
+    // Every third vertex has no g (nor gradient, nor speed); every fifth g but no gradient; every
+    // other one a curvature.
     fields.defined[v] = v % 3 == 0 ? kNormalDefined
                                    : (v % 5 == 0 ? kNormalDefined | kPhotoDefined | kSpeedDefined
                                                  : kNormalDefined | kPhotoDefined | kGradientDefined | kSpeedDefined);
+    if (v % 2 == 0) fields.defined[v] |= kCurvatureDefined;
+    moving_speed[v] = v % 3 == 0 ? 0.0 : 7.0 * x;  // what the refinement records as the vertex moves
     fields.visible_count[v] = static_cast<std::uint16_t>(v % 4);
     fields.patch_kind[v] = static_cast<PatchKind>(v % 3);
     scale[v] = 1.0 / (x + 1.0);
     moved[v] = 0.01 * x;
   }
   IterationVertexFields state{.iteration = 7, .time_step = 0.0625, .mesh = &mesh, .fields = &fields,
-                              .damping_scale = scale, .moved = moved};
+                              .moving_speed = moving_speed, .damping_scale = scale, .moved = moved};
   const fs::path file = path(vertex_fields_file_name(7));
   EXPECT_EQ(file.filename(), "iteration_0007.ply");
   write_vertex_fields(file, state);
@@ -728,20 +731,22 @@ TEST_F(MeshIoTest, VertexFieldsDumpHoldsEveryVertexsStateAndTheFaces) {
     const double x = static_cast<double>(v);
     const auto p = mesh.point(TriMesh::VertexHandle(static_cast<int>(v)));
     const Eigen::Vector3d normal = Eigen::Vector3d(x, 1.0, -2.0).normalized();
-    EXPECT_EQ(dump.value(v, "x"), p[0]);
-    EXPECT_EQ(dump.value(v, "z"), p[2]);
-    EXPECT_EQ(dump.value(v, "ny"), normal.y());
-    EXPECT_EQ(dump.value(v, "mean_curvature"), -x);
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_EQ(dump.value(v, std::string(1, "xyz"[axis])), p[axis]);
+      EXPECT_EQ(dump.value(v, std::string("n") + "xyz"[axis]), normal[axis]);
+    }
+    if (v % 2 == 0)
+      EXPECT_EQ(dump.value(v, "mean_curvature"), -x);
+    else
+      EXPECT_TRUE(std::isnan(dump.value(v, "mean_curvature"))) << v;
+    EXPECT_EQ(dump.value(v, "speed_normal"), moving_speed[v]);
     EXPECT_EQ(dump.value(v, "damping"), 1.0 / (x + 1.0));
     EXPECT_EQ(dump.value(v, "moved"), 0.01 * x);
     const bool has_g = v % 3 != 0, has_gradient = has_g && v % 5 != 0;
-    if (has_g) {
+    if (has_g)
       EXPECT_EQ(dump.value(v, "g"), 0.5 * x + 1.0) << v;
-      EXPECT_NEAR(dump.value(v, "speed_normal"), 10.0 * x, 1e-12 * (1 + x)) << v;
-    } else {
+    else
       EXPECT_TRUE(std::isnan(dump.value(v, "g"))) << v;
-      EXPECT_EQ(dump.value(v, "speed_normal"), 0.0) << v;
-    }
     if (has_gradient)
       EXPECT_NEAR(dump.value(v, "grad_g_normal"), Eigen::Vector3d(x, 2 * x, 3 * x).dot(normal), 1e-12 * (1 + x)) << v;
     else

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -35,12 +36,38 @@ struct RefineArguments {
   int threads = 0;
 };
 
+// A folder for --dump-fields: created if missing, and refused if it holds another run's dumps,
+// whose later iterations would otherwise sit beside this run's as if they were its own.
+void prepare_dump_folder(const std::filesystem::path& folder) {
+  io::prepare_output_folder(folder);
+  for (const auto& entry : std::filesystem::directory_iterator(folder))
+    if (entry.path().filename().string().starts_with("iteration_") && entry.path().extension() == ".ply")
+      throw IoError(folder, "holds per-vertex dumps of another run (" + entry.path().filename().string() +
+                                "): give an empty or new folder to --dump-fields");
+}
+
+// Writes each iteration's dump; a failure (a full disk) ends the dumps with a warning, not the run:
+// they are a diagnostic, the refined mesh is the result.
+std::function<void(const IterationVertexFields&)> dump_writer(const std::filesystem::path& folder,
+                                                               spdlog::logger& log) {
+  return [folder, &log, failed = false](const IterationVertexFields& state) mutable {
+    if (failed) return;
+    try {
+      io::write_vertex_fields(folder / io::vertex_fields_file_name(state.iteration), state);
+    } catch (const IoError& error) {
+      failed = true;
+      log.warn("{}: no more per-vertex dumps after iteration {}; the refinement goes on", error.what(),
+               state.iteration - 1);
+    }
+  };
+}
+
 int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog::logger& log) {
   install_interrupt_handlers();
   // Before the scene is read: a refinement that cannot write its result is not started.
   io::check_writable(args.output);
   if (!args.report.empty()) io::check_writable(args.report);
-  if (!args.dump_fields.empty()) io::prepare_output_folder(args.dump_fields);
+  if (!args.dump_fields.empty()) prepare_dump_folder(args.dump_fields);
   const Scene scene = io::load_scene(args.scene, {.mask_folder = args.masks});
   std::string mesh_file = args.mesh;
   if (mesh_file.empty() && scene.mesh_file) mesh_file = scene.mesh_file->string();
@@ -63,17 +90,15 @@ int run_refine(const RefineArguments& args, const RefineOptions& options, spdlog
       std::fprintf(stderr, "\r\033[K%s: iteration %d/%d, %zu vertices, Σg/vertex %.5g", to_string(p.stage), p.iteration,
                    p.max_iterations, p.vertices, p.sum_g_per_vertex);
   };
-  if (!args.dump_fields.empty())
-    control.on_vertex_fields = [folder = std::filesystem::path(args.dump_fields)](const IterationVertexFields& state) {
-      io::write_vertex_fields(folder / io::vertex_fields_file_name(state.iteration), state);
-    };
+  if (!args.dump_fields.empty()) control.on_vertex_fields = dump_writer(args.dump_fields, log);
   log.info("refining {} ({} vertices) with {} views of {}", mesh_file, initial.n_vertices(), scene.size(),
            scene.folder.string());
   const RefineResult result = refine_mesh(scene, initial, options, control);
   if (live) std::fprintf(stderr, "\r\033[K");
   const RefineSummary& s = result.summary;
   if (s.status == RefineStatus::Cancelled) {
-    log.warn("interrupted after {} iterations: nothing written", s.iterations.size());
+    log.warn("interrupted after {} iterations: nothing written{}", s.iterations.size(),
+             args.dump_fields.empty() ? "" : " but the per-vertex dumps in " + args.dump_fields);
     return kInterrupted;
   }
   if (!args.report.empty()) {
@@ -109,7 +134,8 @@ void add_refine_command(CLI::App& app, Runner& runner) {
   c->add_option("--dump-fields", args->dump_fields,
                 "Folder (created if missing) for one PLY per iteration, iteration_NNNN.ply: the surface after the "
                 "iteration with each vertex's normal, g, H, grad g along N, speed along N, damping scale, move, "
-                "defined bits, views and patch kind (README \"Formats\"); about 100 bytes per vertex and iteration");
+                "defined bits, views and patch kind (README \"Formats\"); about 125 bytes per vertex and iteration; "
+                "refused if it holds another run's dumps");
   c->add_option("--masks", args->masks,
                 "Folder of silhouette masks, one per view named after its photograph (object: any channel > 0): the "
                 "rims are fitted to them (with --fit-silhouettes auto or on) and anchor the unobserved spread, and "

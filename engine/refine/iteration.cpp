@@ -81,6 +81,7 @@ void IterationData::reset_topology() {
   partials.assign(blocks.size(), BlockPartial{});
   new_positions.assign(mesh.n_vertices(), Eigen::Vector3d::Zero());
   moved.assign(mesh.n_vertices(), 0.0);
+  moving_speed.assign(record_moving_speed ? mesh.n_vertices() : 0, 0.0);
   far.assign(mesh.n_vertices(), 0);
   far_count = 0;
   block_seconds.assign(blocks.size(), {});
@@ -254,6 +255,11 @@ void IterationData::move(std::size_t block) {
             [&] {
               if (options.damping.enabled) damp_speeds(blocks[block], options.damping, fields, damping);
               if (time_step > 0.0) carry_momentum(blocks[block], options.momentum, time_step, last_step, fields);
+              if (record_moving_speed)
+                for (std::uint32_t v = blocks[block].begin; v < blocks[block].end; ++v) {
+                  const bool has_speed = fields.defined[v] & (kSpeedDefined | kSpeedFilled);
+                  moving_speed[v] = has_speed ? fields.speed[v].dot(fields.normal[v]) : 0.0;
+                }
               move_vertices(mesh, blocks[block], fields, time_step, move_limit, inside, &moved);
             });
 }

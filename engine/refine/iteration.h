@@ -66,6 +66,11 @@ struct IterationData {
   std::vector<BlockPartial> partials;            //!< one per block
   std::vector<Eigen::Vector3d> new_positions;    //!< Jacobi buffer of smoothing / regularization
   std::vector<double> moved;                     //!< length of each vertex's move this iteration
+  //! When record_moving_speed is set (RefineControl::on_vertex_fields), each vertex's F·N as it
+  //! moved: after the damping and momentum, N the normal F was built along (the regularization
+  //! recomputes fields.normal later in the iteration); 0 for a vertex without a speed.
+  bool record_moving_speed = false;
+  std::vector<double> moving_speed;
   //! For the step momentum and the unobserved-speed fill: the positions at the start of the last
   //! iteration (empty until one ran on this topology), then each vertex's whole step in it (refit()).
   std::vector<Eigen::Vector3d> iteration_start, last_step;

@@ -162,6 +162,7 @@ class Refinement {
     const std::exception_ptr preparing_error = decode_while_preparing(scene);
     views_ = flow_views();
     data_.on_block = control.on_block;
+    data_.record_moving_speed = static_cast<bool>(control.on_vertex_fields);
     for (int level = 0; level < options.image_levels; ++level)
       levels_.push_back(half_resolution(level == 0 ? flow_views() : levels_.back()->views));
     if (!levels_.empty()) views_ = levels_.back()->views;  // the coarsest first
@@ -609,6 +610,7 @@ class Refinement {
     state.fields = &data_.fields;
     if (options_.damping.enabled) state.damping_scale = data_.damping.scale;
     state.moved = data_.moved;
+    state.moving_speed = data_.moving_speed;
     control_.on_vertex_fields(state);
   }
 

@@ -40,8 +40,9 @@ struct RefineControl {
   //! the engine's threads, several at once: keep it short and thread-safe.
   std::function<void(std::size_t block)> on_block;
   std::function<void(const RefineProgress&)> on_progress;
-  //! After each iteration, before its IterationReport's callbacks, on the calling thread: every
-  //! vertex's state (IterationVertexFields). Costs nothing when empty; `refine --dump-fields`.
+  //! After each iteration, before its IterationReport's callbacks, serially (one call at a time,
+  //! between iterations, on one of the run's threads): every vertex's state (IterationVertexFields).
+  //! An exception from it fails the run. Costs nothing when empty; `refine --dump-fields`.
   std::function<void(const IterationVertexFields&)> on_vertex_fields;
 };
 
