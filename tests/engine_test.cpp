@@ -27,50 +27,40 @@
 namespace mvflow {
 namespace {
 
-// A small rendered scene: bumpy sphere, 16 ring views of 320×240, a smoothed offset initial mesh.
+// A rendered scene with its truth and initial mesh (render_bumpy_scene).
 struct SmallScene {
   Scene scene;
   Mesh initial;
   IndexedMesh truth;
 };
 
+// The bumpy sphere at \p level, 16 ring views of 320×240, a smoothed offset initial mesh of about
+// \p init_vertices vertices.
+SmallScene render_bumpy_scene(int level, int init_vertices) {
+  SynthOptions options;
+  options.rig.views = 16;
+  options.rig.width = 320;
+  options.rig.height = 240;
+  options.init.vertices = init_vertices;
+  BuiltinShapeOptions shape;
+  shape.level = level;
+  SmallScene s;
+  s.truth = make_builtin_object("bumpy-sphere", shape);
+  SynthScene synth = make_synth_scene(s.truth, nullptr, options);
+  s.scene = in_memory_scene(std::move(synth.views), std::move(synth.images), synth.bounding_box);
+  s.initial = build_mesh(synth.initial, "initial");
+  return s;
+}
+
 const SmallScene& small_scene() {
-  static const SmallScene cached = [] {
-    SynthOptions options;
-    options.rig.views = 16;
-    options.rig.width = 320;
-    options.rig.height = 240;
-    options.init.vertices = 300;
-    BuiltinShapeOptions shape;
-    shape.level = 4;
-    SmallScene s;
-    s.truth = make_builtin_object("bumpy-sphere", shape);
-    SynthScene synth = make_synth_scene(s.truth, nullptr, options);
-    s.scene = in_memory_scene(std::move(synth.views), std::move(synth.images), synth.bounding_box);
-    s.initial = build_mesh(synth.initial, "initial");
-    return s;
-  }();
+  static const SmallScene cached = render_bumpy_scene(4, 300);
   return cached;
 }
 
 // A scene whose iterations take ≥ 100 ms (0.11 s with 2 threads on the development machine) in
 // thousands of block kernels: the bumpy sphere at level 6, 16 views of 320×240, 40 000 vertices.
 const SmallScene& large_scene() {
-  static const SmallScene cached = [] {
-    SynthOptions options;
-    options.rig.views = 16;
-    options.rig.width = 320;
-    options.rig.height = 240;
-    options.init.vertices = 40000;
-    BuiltinShapeOptions shape;
-    shape.level = 6;
-    SmallScene s;
-    s.truth = make_builtin_object("bumpy-sphere", shape);
-    SynthScene synth = make_synth_scene(s.truth, nullptr, options);
-    s.scene = in_memory_scene(std::move(synth.views), std::move(synth.images), synth.bounding_box);
-    s.initial = build_mesh(synth.initial, "initial");
-    return s;
-  }();
+  static const SmallScene cached = render_bumpy_scene(6, 40000);
   return cached;
 }
 
