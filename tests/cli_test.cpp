@@ -148,8 +148,8 @@ TEST(Cli, RefineDumpsEachIterationsVertexFields) {
   std::vector<std::string> expected;
   for (int k = 1; k <= 6; ++k) expected.push_back("iteration_000" + std::to_string(k) + ".ply");
   EXPECT_EQ(names, expected);
-  // The last one's vertices with g are those the report counts (its "defined_g", read from the
-  // JSON text), and its surface has the report's vertex count.
+  // The last one's vertices with g are those the report counts for its iteration ("defined_g"),
+  // and its surface has the report's vertex count.
   const test::VertexFieldsDump last = test::read_vertex_fields_dump(dumps / "iteration_0006.ply");
   EXPECT_EQ(last.comments.at("iteration"), "6");
   std::size_t with_g = 0;
